@@ -1,0 +1,2 @@
+//! Register-level model of the fabric and the soft-core driver.
+#![no_std]

@@ -1,0 +1,10 @@
+//! Host side of stereocal: link, driver, descriptors, matching, essential matrix, Kalman.
+
+pub mod calib;
+pub mod descriptor;
+pub mod essential;
+pub mod frame;
+pub mod kalman;
+pub mod matching;
+pub mod ransac;
+pub mod synth;

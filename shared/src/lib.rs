@@ -1,0 +1,2 @@
+//! Wire format shared by the soft-core firmware and the host.
+#![no_std]
