@@ -1,1 +1,314 @@
-//! (being written)
+//! The features of one camera frame as the host holds them after reassembling the wire packets.
+//!
+//! Coordinates: keypoints are in full-resolution pixels (x right, y down, pixel centres at
+//! integers). Pixel `(i, j)` of octave `o` sits at full-resolution `(i·2ᵒ, j·2ᵒ)`: each octave
+//! keeps the even pixels of the previous one.
+//!
+//! Gradients come in one of two forms, matching the two transfer modes of the soft-core:
+//! the full Sobel planes of every octave ("full rows", most data, allows sub-pixel match
+//! refinement on octave 0), or one 16×16 window per keypoint ("patches").
+//! Orientation is the fabric's 6-bit CORDIC angle: `k · 360/64°` measured from +x toward +y
+//! (image down), i.e. `atan2(gy, gx)`; magnitude is the fabric's 8-bit `x_n·5/8`.
+
+/// Side length of the gradient window the descriptor is built from.
+pub const PATCH_SIZE: usize = 16;
+/// Number of orientation codes of the fabric (6 bits).
+pub const ORIENTATION_STEPS: u8 = 64;
+
+/// Why a frame could not be assembled.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FrameError {
+    #[error("Sobel plane of octave {octave}: {len} magnitude/orientation samples for {width}x{height}")]
+    PlaneSize {
+        octave: u8,
+        width: u32,
+        height: u32,
+        len: usize,
+    },
+    #[error("Sobel plane of octave {octave}: orientation code {code} at index {index} is not 6-bit")]
+    OrientationRange { octave: u8, index: usize, code: u8 },
+    #[error("{patches} gradient patches for {keypoints} keypoints")]
+    PatchCount { patches: usize, keypoints: usize },
+    #[error("keypoint {index}: coordinates ({x}, {y}) are not finite or outside {width}x{height}")]
+    KeypointPosition {
+        index: usize,
+        x: f32,
+        y: f32,
+        width: u32,
+        height: u32,
+    },
+}
+
+/// One DoG extremum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Keypoint {
+    /// Full-resolution x, including the octave scaling and the sub-pixel offset.
+    pub x: f32,
+    /// Full-resolution y, including the octave scaling and the sub-pixel offset.
+    pub y: f32,
+    /// Pyramid octave (0 = full resolution).
+    pub octave: u8,
+    /// Scale index within the octave, with its sub-scale offset.
+    pub scale: f32,
+    /// DoG response at the extremum (contrast).
+    pub dog: f32,
+}
+
+impl Keypoint {
+    /// Position in the pixel grid of the keypoint's own octave.
+    pub fn octave_position(&self) -> (f32, f32) {
+        let s = (1u32 << self.octave.min(31)) as f32;
+        (self.x / s, self.y / s)
+    }
+}
+
+/// Sobel magnitude and orientation of one octave, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SobelPlane {
+    octave: u8,
+    width: u32,
+    height: u32,
+    magnitude: Vec<u8>,
+    orientation: Vec<u8>,
+}
+
+impl SobelPlane {
+    /// Checks the sizes and that every orientation is a 6-bit code.
+    pub fn new(
+        octave: u8,
+        width: u32,
+        height: u32,
+        magnitude: Vec<u8>,
+        orientation: Vec<u8>,
+    ) -> Result<Self, FrameError> {
+        let n = width as usize * height as usize;
+        if magnitude.len() != n || orientation.len() != n {
+            return Err(FrameError::PlaneSize {
+                octave,
+                width,
+                height,
+                len: magnitude.len().min(orientation.len()),
+            });
+        }
+        if let Some((index, &code)) = orientation
+            .iter()
+            .enumerate()
+            .find(|(_, &c)| c >= ORIENTATION_STEPS)
+        {
+            return Err(FrameError::OrientationRange {
+                octave,
+                index,
+                code,
+            });
+        }
+        Ok(Self {
+            octave,
+            width,
+            height,
+            magnitude,
+            orientation,
+        })
+    }
+
+    pub fn octave(&self) -> u8 {
+        self.octave
+    }
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    pub fn magnitude(&self) -> &[u8] {
+        &self.magnitude
+    }
+    pub fn orientation(&self) -> &[u8] {
+        &self.orientation
+    }
+
+    /// `(magnitude, orientation)` at integer octave coordinates, `None` outside.
+    pub fn get(&self, x: i32, y: i32) -> Option<(u8, u8)> {
+        if x < 0 || y < 0 || x as u32 >= self.width || y as u32 >= self.height {
+            return None;
+        }
+        let i = y as usize * self.width as usize + x as usize;
+        Some((self.magnitude[i], self.orientation[i]))
+    }
+}
+
+/// The 16×16 gradient window around one keypoint at the keypoint's octave, row-major.
+/// Element `(r, c)` is octave pixel `(cx - 8 + c, cy - 8 + r)` with `(cx, cy)` the keypoint's
+/// octave position rounded to the nearest pixel. Samples outside the image are 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SobelPatch {
+    pub magnitude: [u8; PATCH_SIZE * PATCH_SIZE],
+    pub orientation: [u8; PATCH_SIZE * PATCH_SIZE],
+}
+
+/// The gradient data that came with a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Gradients {
+    /// One plane per octave (any order; looked up by octave).
+    Planes(Vec<SobelPlane>),
+    /// One patch per keypoint, index-aligned with `FeatureFrame::keypoints`.
+    Patches(Vec<SobelPatch>),
+}
+
+/// Everything the host knows about one camera frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureFrame {
+    /// Frame counter from the link.
+    pub index: u64,
+    /// Capture time in microseconds (drives the Kalman prediction).
+    pub timestamp_us: u64,
+    /// Full-resolution image size.
+    pub width: u32,
+    pub height: u32,
+    keypoints: Vec<Keypoint>,
+    gradients: Gradients,
+}
+
+impl FeatureFrame {
+    /// Validates keypoint positions and the gradient/keypoint pairing.
+    pub fn new(
+        index: u64,
+        timestamp_us: u64,
+        width: u32,
+        height: u32,
+        keypoints: Vec<Keypoint>,
+        gradients: Gradients,
+    ) -> Result<Self, FrameError> {
+        if let Gradients::Patches(p) = &gradients {
+            if p.len() != keypoints.len() {
+                return Err(FrameError::PatchCount {
+                    patches: p.len(),
+                    keypoints: keypoints.len(),
+                });
+            }
+        }
+        for (i, k) in keypoints.iter().enumerate() {
+            let inside = k.x.is_finite()
+                && k.y.is_finite()
+                && k.x >= -0.5
+                && k.y >= -0.5
+                && k.x <= width as f32 - 0.5
+                && k.y <= height as f32 - 0.5;
+            if !inside {
+                return Err(FrameError::KeypointPosition {
+                    index: i,
+                    x: k.x,
+                    y: k.y,
+                    width,
+                    height,
+                });
+            }
+        }
+        Ok(Self {
+            index,
+            timestamp_us,
+            width,
+            height,
+            keypoints,
+            gradients,
+        })
+    }
+
+    pub fn keypoints(&self) -> &[Keypoint] {
+        &self.keypoints
+    }
+
+    pub fn gradients(&self) -> &Gradients {
+        &self.gradients
+    }
+
+    /// The Sobel plane of `octave`, when the frame carries planes.
+    pub fn plane(&self, octave: u8) -> Option<&SobelPlane> {
+        match &self.gradients {
+            Gradients::Planes(p) => p.iter().find(|p| p.octave == octave),
+            Gradients::Patches(_) => None,
+        }
+    }
+
+    /// `(magnitude, orientation)` of the gradient window of keypoint `k` at window offset
+    /// `(dx, dy)` ∈ [-8, 8)² from its rounded octave position; `None` when unavailable.
+    pub fn window_sample(&self, k: usize, dx: i32, dy: i32) -> Option<(u8, u8)> {
+        let kp = self.keypoints.get(k)?;
+        match &self.gradients {
+            Gradients::Patches(p) => {
+                let half = (PATCH_SIZE / 2) as i32;
+                let (c, r) = (dx + half, dy + half);
+                if !(0..PATCH_SIZE as i32).contains(&c) || !(0..PATCH_SIZE as i32).contains(&r) {
+                    return None;
+                }
+                let i = r as usize * PATCH_SIZE + c as usize;
+                let patch = p.get(k)?;
+                Some((patch.magnitude[i], patch.orientation[i]))
+            }
+            Gradients::Planes(_) => {
+                let plane = self.plane(kp.octave)?;
+                let (ox, oy) = kp.octave_position();
+                plane.get(ox.round() as i32 + dx, oy.round() as i32 + dy)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kp(x: f32, y: f32, octave: u8) -> Keypoint {
+        Keypoint {
+            x,
+            y,
+            octave,
+            scale: 1.0,
+            dog: 10.0,
+        }
+    }
+
+    #[test]
+    fn plane_sizes_and_codes_are_checked() {
+        assert!(matches!(
+            SobelPlane::new(0, 4, 4, vec![0; 15], vec![0; 16]),
+            Err(FrameError::PlaneSize { .. })
+        ));
+        assert!(matches!(
+            SobelPlane::new(1, 2, 2, vec![0; 4], vec![0, 1, 64, 3]),
+            Err(FrameError::OrientationRange { index: 2, code: 64, .. })
+        ));
+        let p = SobelPlane::new(0, 2, 2, vec![1, 2, 3, 4], vec![0, 1, 2, 63]).unwrap();
+        assert_eq!(p.get(1, 1), Some((4, 63)));
+        assert_eq!(p.get(2, 0), None);
+        assert_eq!(p.get(-1, 0), None);
+    }
+
+    #[test]
+    fn frame_checks_keypoints_and_patches() {
+        let patch = SobelPatch {
+            magnitude: [0; 256],
+            orientation: [0; 256],
+        };
+        let err = FeatureFrame::new(0, 0, 10, 10, vec![kp(1.0, 1.0, 0)], Gradients::Patches(vec![]));
+        assert!(matches!(err, Err(FrameError::PatchCount { .. })));
+        let err = FeatureFrame::new(0, 0, 10, 10, vec![kp(f32::NAN, 1.0, 0)], Gradients::Planes(vec![]));
+        assert!(matches!(err, Err(FrameError::KeypointPosition { index: 0, .. })));
+        let f = FeatureFrame::new(0, 0, 10, 10, vec![kp(3.0, 4.0, 0)], Gradients::Patches(vec![patch]))
+            .unwrap();
+        assert_eq!(f.window_sample(0, -8, -8), Some((0, 0)));
+        assert_eq!(f.window_sample(0, 8, 0), None);
+    }
+
+    #[test]
+    fn plane_windows_follow_the_octave_scaling() {
+        // Octave 1 plane of a 8x8 image is 4x4; full-res (4, 2) is octave pixel (2, 1).
+        let mag: Vec<u8> = (0..16).collect();
+        let plane = SobelPlane::new(1, 4, 4, mag, vec![0; 16]).unwrap();
+        let f = FeatureFrame::new(0, 0, 8, 8, vec![kp(4.0, 2.0, 1)], Gradients::Planes(vec![plane]))
+            .unwrap();
+        assert_eq!(f.window_sample(0, 0, 0), Some((6, 0)));
+        assert_eq!(f.window_sample(0, 1, 1), Some((11, 0)));
+        assert!(f.plane(0).is_none());
+    }
+}

@@ -1,1 +1,219 @@
-//! (being written)
+//! Nearest-neighbour matching of left and right descriptors (thesis 4.4.3).
+//!
+//! Candidates are the right keypoints within a vertical band around the left keypoint (on a
+//! verge head the vertical disparity stays a few pixels, so the band removes most false
+//! candidates and most of the work); the best candidate must beat the second best by the
+//! ratio test; optionally the match must also be the left keypoint's best from the right
+//! side (left-right consistency); optionally only the N best are kept.
+//!
+//! Distances are squared Euclidean over `u8` elements accumulated in `u32`: a plain loop over
+//! fixed-size chunks that the compiler turns into SIMD.
+
+use crate::descriptor::DescriptorSet;
+use crate::frame::Keypoint;
+
+/// Matching settings; the default is the most accurate for a verge head.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatchConfig {
+    /// Lowe's ratio: best distance < ratio · second-best distance (thesis: 0.6).
+    pub ratio: f32,
+    /// Require the match to be mutual (left's best is right's best).
+    pub cross_check: bool,
+    /// Keep only the N matches with the smallest descriptor distance (thesis: 20). `None`
+    /// keeps every match that passes: the refinement needs many matches for sub-0.05°
+    /// accuracy, and it is robust to the few extra outliers.
+    pub best_n: Option<usize>,
+    /// Only right keypoints with |y_r - y_l| ≤ this (full-resolution pixels) are candidates.
+    pub max_vertical_px: Option<f32>,
+}
+
+impl Default for MatchConfig {
+    fn default() -> Self {
+        Self {
+            ratio: 0.6,
+            cross_check: true,
+            best_n: None,
+            max_vertical_px: Some(24.0),
+        }
+    }
+}
+
+/// One accepted match.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Match {
+    /// Index into the left frame's keypoints.
+    pub left: u32,
+    /// Index into the right frame's keypoints.
+    pub right: u32,
+    /// Euclidean descriptor distance (in the u8 descriptor scale).
+    pub distance: f32,
+    /// best / second-best distance (≤ ratio).
+    pub ratio: f32,
+}
+
+/// Squared Euclidean distance of two descriptors of equal length.
+#[inline]
+pub fn distance_sq(a: &[u8], b: &[u8]) -> u32 {
+    // 16-wide chunks: the compiler widens to i16/i32 lanes and vectorises each chunk.
+    let mut acc = 0u32;
+    let mut ca = a.chunks_exact(16);
+    let mut cb = b.chunks_exact(16);
+    for (x, y) in (&mut ca).zip(&mut cb) {
+        let mut s = 0u32;
+        for i in 0..16 {
+            let d = x[i] as i32 - y[i] as i32;
+            s += (d * d) as u32;
+        }
+        acc += s;
+    }
+    for (&x, &y) in ca.remainder().iter().zip(cb.remainder()) {
+        let d = x as i32 - y as i32;
+        acc += (d * d) as u32;
+    }
+    acc
+}
+
+/// Matches the left descriptors against the right ones. Keypoint slices are the frames'
+/// keypoints (the sets index into them). Output sorted by increasing distance.
+pub fn match_descriptors(
+    left: &DescriptorSet,
+    left_kp: &[Keypoint],
+    right: &DescriptorSet,
+    right_kp: &[Keypoint],
+    config: &MatchConfig,
+) -> Vec<Match> {
+    if left.is_empty() || right.is_empty() || left.dim() != right.dim() {
+        return Vec::new();
+    }
+    // Right descriptors sorted by y for the vertical band lookup.
+    let mut order: Vec<u32> = (0..right.len() as u32).collect();
+    let ry = |j: u32| right_kp[right.keypoint(j as usize)].y;
+    order.sort_by(|&a, &b| ry(a).total_cmp(&ry(b)));
+    let ys: Vec<f32> = order.iter().map(|&j| ry(j)).collect();
+    let band = config.max_vertical_px.unwrap_or(f32::INFINITY);
+
+    // Best left (distance, index) per right descriptor, for the cross check.
+    let mut right_best = vec![(u32::MAX, u32::MAX); right.len()];
+    let mut candidates = Vec::with_capacity(left.len());
+    for i in 0..left.len() {
+        let yl = left_kp[left.keypoint(i)].y;
+        let lo = ys.partition_point(|&y| y < yl - band);
+        let hi = ys.partition_point(|&y| y <= yl + band);
+        let d = left.get(i);
+        let (mut b1, mut b2, mut j1) = (u32::MAX, u32::MAX, u32::MAX);
+        for &j in &order[lo..hi] {
+            let dist = distance_sq(d, right.get(j as usize));
+            if dist < b1 {
+                b2 = b1;
+                b1 = dist;
+                j1 = j;
+            } else if dist < b2 {
+                b2 = dist;
+            }
+            let rb = &mut right_best[j as usize];
+            if dist < rb.0 {
+                *rb = (dist, i as u32);
+            }
+        }
+        if j1 != u32::MAX {
+            candidates.push((i as u32, j1, b1, b2));
+        }
+    }
+    let r2 = config.ratio * config.ratio;
+    let mut out: Vec<Match> = candidates
+        .into_iter()
+        .filter(|&(i, j, b1, b2)| {
+            let ratio_ok = b2 == u32::MAX || (b1 as f32) < r2 * b2 as f32;
+            ratio_ok && (!config.cross_check || right_best[j as usize].1 == i)
+        })
+        .map(|(i, j, b1, b2)| Match {
+            left: left.keypoint(i as usize) as u32,
+            right: right.keypoint(j as usize) as u32,
+            distance: (b1 as f32).sqrt(),
+            ratio: if b2 == u32::MAX {
+                0.0
+            } else {
+                (b1 as f32 / b2 as f32).sqrt()
+            },
+        })
+        .collect();
+    out.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+    if let Some(n) = config.best_n {
+        out.truncate(n);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::descriptor::{describe, DescriptorConfig};
+    use crate::frame::{FeatureFrame, Gradients, SobelPlane};
+    use proptest::prelude::*;
+
+    fn textured(width: u32, height: u32, dx: i32, dy: i32) -> SobelPlane {
+        let mut mag = Vec::new();
+        let mut ori = Vec::new();
+        for y in 0..height as i32 {
+            for x in 0..width as i32 {
+                let h = ((x - dx).wrapping_mul(73856093) ^ (y - dy).wrapping_mul(19349663)) as u32;
+                mag.push((h % 200) as u8 + 20);
+                ori.push(((h >> 8) % 64) as u8);
+            }
+        }
+        SobelPlane::new(0, width, height, mag, ori).unwrap()
+    }
+
+    fn frame(plane: SobelPlane, pts: &[(f32, f32)]) -> FeatureFrame {
+        let kps = pts
+            .iter()
+            .map(|&(x, y)| Keypoint {
+                x,
+                y,
+                octave: 0,
+                scale: 1.0,
+                dog: 1.0,
+            })
+            .collect();
+        let (w, h) = (plane.width(), plane.height());
+        FeatureFrame::new(0, 0, w, h, kps, Gradients::Planes(vec![plane])).unwrap()
+    }
+
+    #[test]
+    fn shifted_texture_matches_its_own_points() {
+        let pts: Vec<(f32, f32)> = (0..40)
+            .map(|i| (20.0 + (i % 8) as f32 * 25.0, 20.0 + (i / 8) as f32 * 25.0))
+            .collect();
+        let right_pts: Vec<(f32, f32)> = pts.iter().rev().map(|&(x, y)| (x - 7.0, y + 1.0)).collect();
+        let l = frame(textured(240, 160, 0, 0), &pts);
+        let r = frame(textured(240, 160, -7, 1), &right_pts);
+        let cfg = DescriptorConfig::default();
+        let (dl, dr) = (describe(&l, &cfg), describe(&r, &cfg));
+        let m = match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &MatchConfig::default());
+        assert_eq!(m.len(), 40);
+        assert!(m.iter().all(|m| m.left + m.right == 39 && m.distance == 0.0));
+        let few = MatchConfig {
+            best_n: Some(20),
+            ..MatchConfig::default()
+        };
+        assert_eq!(
+            match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &few).len(),
+            20
+        );
+        // A 0-pixel band excludes the right points (they are 1 px lower).
+        let tight = MatchConfig {
+            max_vertical_px: Some(0.5),
+            ..MatchConfig::default()
+        };
+        assert!(match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &tight).is_empty());
+    }
+
+    proptest! {
+        #[test]
+        fn distance_matches_the_plain_formula(a in proptest::collection::vec(any::<u8>(), 0..140), seed in any::<u8>()) {
+            let b: Vec<u8> = a.iter().map(|v| v.wrapping_mul(seed).wrapping_add(3)).collect();
+            let plain: u64 = a.iter().zip(&b).map(|(&x, &y)| ((x as i64 - y as i64).pow(2)) as u64).sum();
+            prop_assert_eq!(distance_sq(&a, &b) as u64, plain);
+        }
+    }
+}
