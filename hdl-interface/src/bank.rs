@@ -180,7 +180,8 @@ mod tests {
         assert_eq!(bank.read(version::OFFSET), version::RESET);
         bank.device_set_field(&point_fifo_level::LEVEL, 77).unwrap();
         assert_eq!(bank.read(point_fifo_level::OFFSET), 77);
-        bank.device_write(point_overflow_count::OFFSET, u32::MAX).unwrap();
+        bank.device_write(point_overflow_count::OFFSET, u32::MAX)
+            .unwrap();
         assert_eq!(bank.read_field(&point_overflow_count::COUNT), u32::MAX);
         assert_eq!(bank.bus_errors(), 0);
     }
@@ -193,8 +194,15 @@ mod tests {
         bank.device_set_field(&status::POINT_OVERFLOW, 1).unwrap();
         bank.write(status::OFFSET, 0);
         assert_eq!(bank.read(status::OFFSET), 0b0111);
-        bank.write(status::OFFSET, status::FRAME_DONE.mask() | status::BUSY.mask());
-        assert_eq!(bank.read(status::OFFSET), 0b0101, "BUSY is ro, FRAME_DONE cleared");
+        bank.write(
+            status::OFFSET,
+            status::FRAME_DONE.mask() | status::BUSY.mask(),
+        );
+        assert_eq!(
+            bank.read(status::OFFSET),
+            0b0101,
+            "BUSY is ro, FRAME_DONE cleared"
+        );
         bank.write_field(&status::POINT_OVERFLOW, 1).unwrap();
         assert_eq!(bank.read(status::OFFSET), 0b0001);
     }
@@ -207,7 +215,11 @@ mod tests {
         assert_eq!(bank.read(control::OFFSET), control::ENABLE.mask());
         assert_eq!(bank.device_take_field(&control::FRAME_ARM), Ok(1));
         assert_eq!(bank.device_take_field(&control::FRAME_ARM), Ok(0));
-        assert_eq!(bank.device_field(&control::ENABLE), Ok(1), "ENABLE kept by the RMW");
+        assert_eq!(
+            bank.device_field(&control::ENABLE),
+            Ok(1),
+            "ENABLE kept by the RMW"
+        );
     }
 
     #[test]
@@ -227,7 +239,11 @@ mod tests {
                 max: regs::MAX_WIDTH
             })
         );
-        assert_eq!(bank.read_field(&width::VALUE), 640, "a rejected write changes nothing");
+        assert_eq!(
+            bank.read_field(&width::VALUE),
+            640,
+            "a rejected write changes nothing"
+        );
         assert_eq!(
             bank.write_field(&point_fifo_level::LEVEL, 1),
             Err(Error::FieldReadOnly {
@@ -249,13 +265,22 @@ mod tests {
     fn out_of_map_offsets_are_typed_errors_and_counted_bus_errors() {
         let mut bank = RegisterBank::new();
         assert_eq!(bank.try_read(2), Err(Error::MisalignedOffset { offset: 2 }));
-        assert_eq!(bank.try_write(0xFC, 1), Err(Error::UnmappedOffset { offset: 0xFC }));
-        assert_eq!(bank.device_read(u16::MAX), Err(Error::MisalignedOffset { offset: u16::MAX }));
+        assert_eq!(
+            bank.try_write(0xFC, 1),
+            Err(Error::UnmappedOffset { offset: 0xFC })
+        );
+        assert_eq!(
+            bank.device_read(u16::MAX),
+            Err(Error::MisalignedOffset { offset: u16::MAX })
+        );
         let before = bank.clone();
         assert_eq!(bank.read(0xFC), 0);
         bank.write(0x1000, 5);
         assert_eq!(bank.bus_errors(), 2);
-        assert_eq!(bank.last_bus_error(), Some(Error::UnmappedOffset { offset: 0x1000 }));
+        assert_eq!(
+            bank.last_bus_error(),
+            Some(Error::UnmappedOffset { offset: 0x1000 })
+        );
         for r in regs::REGISTERS.iter() {
             assert_eq!(bank.device_read(r.offset), before.device_read(r.offset));
         }

@@ -120,7 +120,10 @@ mod tests {
     #[test]
     fn default_is_the_reset_state() {
         let mut bank = RegisterBank::new();
-        assert_eq!(FabricConfig::read_from(&mut bank), Ok(FabricConfig::default()));
+        assert_eq!(
+            FabricConfig::read_from(&mut bank),
+            Ok(FabricConfig::default())
+        );
     }
 
     #[test]
@@ -160,7 +163,10 @@ mod tests {
         };
         assert!(matches!(
             zero_octaves.write_to(&mut bank),
-            Err(Error::FieldOutOfRange { field: "OCTAVES.COUNT", .. })
+            Err(Error::FieldOutOfRange {
+                field: "OCTAVES.COUNT",
+                ..
+            })
         ));
         assert_eq!(bank, RegisterBank::new());
     }
@@ -171,7 +177,11 @@ mod tests {
         bank.write(octaves::OFFSET, 7);
         assert!(matches!(
             FabricConfig::read_from(&mut bank),
-            Err(Error::FieldOutOfRange { field: "OCTAVES.COUNT", value: 7, .. })
+            Err(Error::FieldOutOfRange {
+                field: "OCTAVES.COUNT",
+                value: 7,
+                ..
+            })
         ));
     }
 }

@@ -20,7 +20,11 @@ pub enum Error {
     /// The bus cannot write this field (it is `ro`).
     FieldReadOnly { field: &'static str },
     /// Width and height must be multiples of `2^(octaves - 1)` so each octave has whole pixels.
-    FrameNotDivisible { width: u16, height: u16, octaves: u8 },
+    FrameNotDivisible {
+        width: u16,
+        height: u16,
+        octaves: u8,
+    },
     /// A field holds a code that names no value of its enum.
     UnknownEnumValue { field: &'static str, value: u32 },
 }
@@ -34,11 +38,20 @@ impl fmt::Display for Error {
             Error::UnmappedOffset { offset } => {
                 write!(f, "no register at offset {offset:#06x}")
             }
-            Error::FieldOutOfRange { field, value, min, max } => {
+            Error::FieldOutOfRange {
+                field,
+                value,
+                min,
+                max,
+            } => {
                 write!(f, "{field} = {value} is outside {min}..={max}")
             }
             Error::FieldReadOnly { field } => write!(f, "{field} is read-only"),
-            Error::FrameNotDivisible { width, height, octaves } => write!(
+            Error::FrameNotDivisible {
+                width,
+                height,
+                octaves,
+            } => write!(
                 f,
                 "frame {width}x{height} is not a multiple of {} as {octaves} octaves need",
                 1u32 << octaves.saturating_sub(1).min(31)

@@ -78,25 +78,27 @@ mod tests {
     fn reads_and_writes_land_on_the_word_at_the_offset() {
         let mut window = [0u32; WORDS];
         window[usize::from(width::OFFSET) / 4] = 1280;
-        // SAFETY: `window` is aligned, WINDOW_SIZE bytes long and outlives `bus`; it is only
-        // touched through `bus` until `bus` is dropped.
-        let mut bus = unsafe { Mmio::new(window.as_mut_ptr() as usize) };
-        assert_eq!(bus.read(width::OFFSET), 1280);
-        bus.write(control::OFFSET, 0x1);
-        drop(bus);
+        {
+            // SAFETY: `window` is aligned, WINDOW_SIZE bytes long and outlives `bus`; it is
+            // only touched through `bus` in this block.
+            let mut bus = unsafe { Mmio::new(window.as_mut_ptr() as usize) };
+            assert_eq!(bus.read(width::OFFSET), 1280);
+            bus.write(control::OFFSET, 0x1);
+        }
         assert_eq!(window[usize::from(control::OFFSET) / 4], 0x1);
     }
 
     #[test]
     fn misaligned_and_out_of_window_offsets_never_touch_memory() {
         let mut window = [0xAAAA_AAAAu32; WORDS];
-        // SAFETY: as above.
-        let mut bus = unsafe { Mmio::new(window.as_mut_ptr() as usize) };
-        assert_eq!(bus.read(2), 0);
-        assert_eq!(bus.read(regs::WINDOW_SIZE as u16), 0);
-        bus.write(6, 0);
-        bus.write(u16::MAX, 0);
-        drop(bus);
+        {
+            // SAFETY: as above.
+            let mut bus = unsafe { Mmio::new(window.as_mut_ptr() as usize) };
+            assert_eq!(bus.read(2), 0);
+            assert_eq!(bus.read(regs::WINDOW_SIZE as u16), 0);
+            bus.write(6, 0);
+            bus.write(u16::MAX, 0);
+        }
         assert!(window.iter().all(|&w| w == 0xAAAA_AAAA));
     }
 }

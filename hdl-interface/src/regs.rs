@@ -51,7 +51,7 @@ pub mod version {
         pops_on_read: false,
     };
 
-    /// [7:0] ro, reset 0: Register-map minor version (additive changes only).
+    /// `[7:0]` ro, reset 0: Register-map minor version (additive changes only).
     pub const MINOR: Field = Field {
         name: "VERSION.MINOR",
         offset: OFFSET,
@@ -62,7 +62,7 @@ pub mod version {
         max: 255,
     };
 
-    /// [15:8] ro, reset 1: Register-map major version (incompatible changes).
+    /// `[15:8]` ro, reset 1: Register-map major version (incompatible changes).
     pub const MAJOR: Field = Field {
         name: "VERSION.MAJOR",
         offset: OFFSET,
@@ -73,7 +73,7 @@ pub mod version {
         max: 255,
     };
 
-    /// [31:16] ro, reset 0x5C01: Constant 0x5C01: a read of anything else means no stereocal fabric at this address.
+    /// `[31:16]` ro, reset 0x5C01: Constant 0x5C01: a read of anything else means no stereocal fabric at this address.
     pub const MAGIC: Field = Field {
         name: "VERSION.MAGIC",
         offset: OFFSET,
@@ -106,7 +106,7 @@ pub mod control {
         pops_on_read: false,
     };
 
-    /// [0:0] rw, reset 0: 1: the pipeline runs. 0: PIXEL_IN ready is held low and no stage advances.
+    /// `[0:0]` rw, reset 0: 1: the pipeline runs. 0: PIXEL_IN ready is held low and no stage advances.
     pub const ENABLE: Field = Field {
         name: "CONTROL.ENABLE",
         offset: OFFSET,
@@ -117,7 +117,7 @@ pub mod control {
         max: 1,
     };
 
-    /// [1:1] wo, reset 0: Write 1 to process the next frame: the pipeline takes the next start-of-frame on PIXEL_IN and every pixel up to the end of that frame. Ignored while STATUS.BUSY is 1.
+    /// `[1:1]` wo, reset 0: Write 1 to process the next frame: the pipeline takes the next start-of-frame on PIXEL_IN and every pixel up to the end of that frame. Ignored while STATUS.BUSY is 1.
     pub const FRAME_ARM: Field = Field {
         name: "CONTROL.FRAME_ARM",
         offset: OFFSET,
@@ -128,7 +128,7 @@ pub mod control {
         max: 1,
     };
 
-    /// [2:2] wo, reset 0: Write 1 to empty both FIFOs, clear the pipeline, STATUS and the counters. Configuration registers keep their values.
+    /// `[2:2]` wo, reset 0: Write 1 to empty both FIFOs, clear the pipeline, STATUS and the counters. Configuration registers keep their values.
     pub const SOFT_RESET: Field = Field {
         name: "CONTROL.SOFT_RESET",
         offset: OFFSET,
@@ -161,7 +161,7 @@ pub mod status {
         pops_on_read: false,
     };
 
-    /// [0:0] ro, reset 0: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs.
+    /// `[0:0]` ro, reset 0: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs.
     pub const BUSY: Field = Field {
         name: "STATUS.BUSY",
         offset: OFFSET,
@@ -172,7 +172,7 @@ pub mod status {
         max: 1,
     };
 
-    /// [1:1] w1c, reset 0: Set when BUSY falls: every entry of the frame is in the FIFOs.
+    /// `[1:1]` w1c, reset 0: Set when BUSY falls: every entry of the frame is in the FIFOs.
     pub const FRAME_DONE: Field = Field {
         name: "STATUS.FRAME_DONE",
         offset: OFFSET,
@@ -183,7 +183,7 @@ pub mod status {
         max: 1,
     };
 
-    /// [2:2] w1c, reset 0: Set when a point was dropped because the point FIFO was full (see POINT_OVERFLOW_COUNT).
+    /// `[2:2]` w1c, reset 0: Set when a point was dropped because the point FIFO was full (see POINT_OVERFLOW_COUNT).
     pub const POINT_OVERFLOW: Field = Field {
         name: "STATUS.POINT_OVERFLOW",
         offset: OFFSET,
@@ -194,7 +194,7 @@ pub mod status {
         max: 1,
     };
 
-    /// [3:3] w1c, reset 0: Set when a Sobel entry was dropped because the Sobel FIFO was full (see SOBEL_OVERFLOW_COUNT).
+    /// `[3:3]` w1c, reset 0: Set when a Sobel entry was dropped because the Sobel FIFO was full (see SOBEL_OVERFLOW_COUNT).
     pub const SOBEL_OVERFLOW: Field = Field {
         name: "STATUS.SOBEL_OVERFLOW",
         offset: OFFSET,
@@ -227,7 +227,7 @@ pub mod width {
         pops_on_read: false,
     };
 
-    /// [15:0] rw, reset 640, valid 16..=1280: Line length in pixels. Must be a multiple of 2^(OCTAVES-1) so every octave has whole pixels.
+    /// `[15:0]` rw, reset 640, valid 16..=1280: Line length in pixels. Must be a multiple of 2^(OCTAVES-1) so every octave has whole pixels.
     pub const VALUE: Field = Field {
         name: "WIDTH.VALUE",
         offset: OFFSET,
@@ -260,7 +260,7 @@ pub mod height {
         pops_on_read: false,
     };
 
-    /// [15:0] rw, reset 480, valid 16..=1024: Lines per frame. Must be a multiple of 2^(OCTAVES-1).
+    /// `[15:0]` rw, reset 480, valid 16..=1024: Lines per frame. Must be a multiple of 2^(OCTAVES-1).
     pub const VALUE: Field = Field {
         name: "HEIGHT.VALUE",
         offset: OFFSET,
@@ -293,7 +293,7 @@ pub mod octaves {
         pops_on_read: false,
     };
 
-    /// [2:0] rw, reset 4, valid 1..=4: Octaves computed; octave k+1 is octave k's last scale subsampled by 2.
+    /// `[2:0]` rw, reset 4, valid 1..=4: Octaves computed; octave k+1 is octave k's last scale subsampled by 2.
     pub const COUNT: Field = Field {
         name: "OCTAVES.COUNT",
         offset: OFFSET,
@@ -326,7 +326,7 @@ pub mod contrast_threshold {
         pops_on_read: false,
     };
 
-    /// [7:0] rw, reset 8: An extremum is kept only if |DoG| >= VALUE. DoG units are grey levels of the 8-bit smoothed images (a DoG sample is the difference of two of them, -255..255); 8 is about Lowe's 0.03 of full scale.
+    /// `[7:0]` rw, reset 8: An extremum is kept only if |DoG| >= VALUE. DoG units are grey levels of the 8-bit smoothed images (a DoG sample is the difference of two of them, -255..255); 8 is about Lowe's 0.03 of full scale.
     pub const VALUE: Field = Field {
         name: "CONTRAST_THRESHOLD.VALUE",
         offset: OFFSET,
@@ -359,7 +359,7 @@ pub mod edge_threshold {
         pops_on_read: false,
     };
 
-    /// [4:0] rw, reset 10, valid 1..=31: Ratio r of the Hessian's principal curvatures: an extremum is kept only if Tr(H)^2 * r < (r + 1)^2 * Det(H), computed in integers on the 2x2 DoG Hessian.
+    /// `[4:0]` rw, reset 10, valid 1..=31: Ratio r of the Hessian's principal curvatures: an extremum is kept only if Tr(H)^2 * r < (r + 1)^2 * Det(H), computed in integers on the 2x2 DoG Hessian.
     pub const R: Field = Field {
         name: "EDGE_THRESHOLD.R",
         offset: OFFSET,
@@ -392,7 +392,7 @@ pub mod output_mode {
         pops_on_read: false,
     };
 
-    /// [0:0] rw, reset 1: Which Sobel entries reach SOBEL_OUT.
+    /// `[0:0]` rw, reset 1: Which Sobel entries reach SOBEL_OUT.
     pub const SOBEL_OUTPUT: Field = Field {
         name: "OUTPUT_MODE.SOBEL_OUTPUT",
         offset: OFFSET,
@@ -432,7 +432,7 @@ pub mod output_mode {
     /// [`SOBEL_OUTPUT`] after reset.
     pub const SOBEL_OUTPUT_RESET: SobelOutput = SobelOutput::Patches;
 
-    /// [5:4] rw, reset 1, valid 0..=3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit.
+    /// `[5:4]` rw, reset 1, valid 0..=3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit.
     pub const SOBEL_SCALE: Field = Field {
         name: "OUTPUT_MODE.SOBEL_SCALE",
         offset: OFFSET,
@@ -465,7 +465,7 @@ pub mod point_fifo_level {
         pops_on_read: false,
     };
 
-    /// [15:0] ro, reset 0, valid 0..=512: Entries waiting in the point FIFO.
+    /// `[15:0]` ro, reset 0, valid 0..=512: Entries waiting in the point FIFO.
     pub const LEVEL: Field = Field {
         name: "POINT_FIFO_LEVEL.LEVEL",
         offset: OFFSET,
@@ -498,7 +498,7 @@ pub mod sobel_fifo_level {
         pops_on_read: false,
     };
 
-    /// [15:0] ro, reset 0, valid 0..=4096: Entries waiting in the Sobel FIFO.
+    /// `[15:0]` ro, reset 0, valid 0..=4096: Entries waiting in the Sobel FIFO.
     pub const LEVEL: Field = Field {
         name: "SOBEL_FIFO_LEVEL.LEVEL",
         offset: OFFSET,
@@ -531,7 +531,7 @@ pub mod point_overflow_count {
         pops_on_read: false,
     };
 
-    /// [31:0] ro, reset 0: Saturates at 0xFFFF_FFFF; cleared by CONTROL.SOFT_RESET.
+    /// `[31:0]` ro, reset 0: Saturates at 0xFFFF_FFFF; cleared by CONTROL.SOFT_RESET.
     pub const COUNT: Field = Field {
         name: "POINT_OVERFLOW_COUNT.COUNT",
         offset: OFFSET,
@@ -564,7 +564,7 @@ pub mod sobel_overflow_count {
         pops_on_read: false,
     };
 
-    /// [31:0] ro, reset 0: Saturates at 0xFFFF_FFFF; cleared by CONTROL.SOFT_RESET.
+    /// `[31:0]` ro, reset 0: Saturates at 0xFFFF_FFFF; cleared by CONTROL.SOFT_RESET.
     pub const COUNT: Field = Field {
         name: "SOBEL_OVERFLOW_COUNT.COUNT",
         offset: OFFSET,
@@ -597,7 +597,7 @@ pub mod frame_count {
         pops_on_read: false,
     };
 
-    /// [31:0] ro, reset 0: Incremented when STATUS.FRAME_DONE is set; wraps modulo 2^32; cleared by CONTROL.SOFT_RESET.
+    /// `[31:0]` ro, reset 0: Incremented when STATUS.FRAME_DONE is set; wraps modulo 2^32; cleared by CONTROL.SOFT_RESET.
     pub const COUNT: Field = Field {
         name: "FRAME_COUNT.COUNT",
         offset: OFFSET,
@@ -630,7 +630,7 @@ pub mod latency_clocks {
         pops_on_read: false,
     };
 
-    /// [31:0] ro, reset 0: Clocks from the first pixel accepted on PIXEL_IN to the first pixel of the last octave's first scale; 0 until a frame has reached the last octave.
+    /// `[31:0]` ro, reset 0: Clocks from the first pixel accepted on PIXEL_IN to the first pixel of the last octave's first scale; 0 until a frame has reached the last octave.
     pub const CLOCKS: Field = Field {
         name: "LATENCY_CLOCKS.CLOCKS",
         offset: OFFSET,
@@ -663,7 +663,7 @@ pub mod point_fifo_data {
         pops_on_read: true,
     };
 
-    /// [10:0] ro, reset 0: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
+    /// `[10:0]` ro, reset 0: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
     pub const X: Field = Field {
         name: "POINT_FIFO_DATA.X",
         offset: OFFSET,
@@ -674,7 +674,7 @@ pub mod point_fifo_data {
         max: 2047,
     };
 
-    /// [21:11] ro, reset 0: Row in the point's own octave.
+    /// `[21:11]` ro, reset 0: Row in the point's own octave.
     pub const Y: Field = Field {
         name: "POINT_FIFO_DATA.Y",
         offset: OFFSET,
@@ -685,7 +685,7 @@ pub mod point_fifo_data {
         max: 2047,
     };
 
-    /// [23:22] ro, reset 0: Octave index, 0 = full resolution.
+    /// `[23:22]` ro, reset 0: Octave index, 0 = full resolution.
     pub const OCTAVE: Field = Field {
         name: "POINT_FIFO_DATA.OCTAVE",
         offset: OFFSET,
@@ -696,7 +696,7 @@ pub mod point_fifo_data {
         max: 3,
     };
 
-    /// [25:24] ro, reset 0: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
+    /// `[25:24]` ro, reset 0: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
     pub const SCALE: Field = Field {
         name: "POINT_FIFO_DATA.SCALE",
         offset: OFFSET,
@@ -707,7 +707,7 @@ pub mod point_fifo_data {
         max: 3,
     };
 
-    /// [26:26] ro, reset 0: 1: a maximum of the DoG, 0: a minimum.
+    /// `[26:26]` ro, reset 0: 1: a maximum of the DoG, 0: a minimum.
     pub const POLARITY: Field = Field {
         name: "POINT_FIFO_DATA.POLARITY",
         offset: OFFSET,
@@ -718,7 +718,7 @@ pub mod point_fifo_data {
         max: 1,
     };
 
-    /// [31:31] ro, reset 0: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed.
+    /// `[31:31]` ro, reset 0: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed.
     pub const VALID: Field = Field {
         name: "POINT_FIFO_DATA.VALID",
         offset: OFFSET,
@@ -751,7 +751,7 @@ pub mod sobel_fifo_data {
         pops_on_read: true,
     };
 
-    /// [7:0] ro, reset 0: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
+    /// `[7:0]` ro, reset 0: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
     pub const MAGNITUDE: Field = Field {
         name: "SOBEL_FIFO_DATA.MAGNITUDE",
         offset: OFFSET,
@@ -762,7 +762,7 @@ pub mod sobel_fifo_data {
         max: 255,
     };
 
-    /// [13:8] ro, reset 0: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
+    /// `[13:8]` ro, reset 0: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
     pub const ORIENTATION: Field = Field {
         name: "SOBEL_FIFO_DATA.ORIENTATION",
         offset: OFFSET,
@@ -773,7 +773,7 @@ pub mod sobel_fifo_data {
         max: 63,
     };
 
-    /// [14:14] ro, reset 0: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
+    /// `[14:14]` ro, reset 0: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
     pub const FIRST: Field = Field {
         name: "SOBEL_FIFO_DATA.FIRST",
         offset: OFFSET,
@@ -784,7 +784,7 @@ pub mod sobel_fifo_data {
         max: 1,
     };
 
-    /// [31:31] ro, reset 0: 1: the other fields hold a Sobel entry (and the read removed it). 0: the FIFO was empty; nothing was removed.
+    /// `[31:31]` ro, reset 0: 1: the other fields hold a Sobel entry (and the read removed it). 0: the FIFO was empty; nothing was removed.
     pub const VALID: Field = Field {
         name: "SOBEL_FIFO_DATA.VALID",
         offset: OFFSET,
@@ -850,15 +850,15 @@ pub mod ports {
         pub const VALID_WIDTH: u32 = 1;
         /// Width of `READY` (in): The FIFO has room; when 0 the point is dropped and counted.
         pub const READY_WIDTH: u32 = 1;
-        /// DATA[10:0]: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
+        /// `DATA[10:0]`: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
         pub const X: BitRange = BitRange { lsb: 0, width: 11 };
-        /// DATA[21:11]: Row in the point's own octave.
+        /// `DATA[21:11]`: Row in the point's own octave.
         pub const Y: BitRange = BitRange { lsb: 11, width: 11 };
-        /// DATA[23:22]: Octave index, 0 = full resolution.
+        /// `DATA[23:22]`: Octave index, 0 = full resolution.
         pub const OCTAVE: BitRange = BitRange { lsb: 22, width: 2 };
-        /// DATA[25:24]: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
+        /// `DATA[25:24]`: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
         pub const SCALE: BitRange = BitRange { lsb: 24, width: 2 };
-        /// DATA[26:26]: 1: a maximum of the DoG, 0: a minimum.
+        /// `DATA[26:26]`: 1: a maximum of the DoG, 0: a minimum.
         pub const POLARITY: BitRange = BitRange { lsb: 26, width: 1 };
     }
 
@@ -873,11 +873,11 @@ pub mod ports {
         pub const VALID_WIDTH: u32 = 1;
         /// Width of `READY` (in): The FIFO has room; when 0 the sample is dropped and counted.
         pub const READY_WIDTH: u32 = 1;
-        /// DATA[7:0]: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
+        /// `DATA[7:0]`: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
         pub const MAGNITUDE: BitRange = BitRange { lsb: 0, width: 8 };
-        /// DATA[13:8]: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
+        /// `DATA[13:8]`: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
         pub const ORIENTATION: BitRange = BitRange { lsb: 8, width: 6 };
-        /// DATA[14:14]: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
+        /// `DATA[14:14]`: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
         pub const FIRST: BitRange = BitRange { lsb: 14, width: 1 };
     }
 }

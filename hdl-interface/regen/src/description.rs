@@ -307,7 +307,10 @@ fn check_name(at: &str, name: &str) -> Result<(), RegenError> {
 fn check_bits(at: &str, bits: [u32; 2], word_width: u32) -> Result<(u32, u32), RegenError> {
     let [msb, lsb] = bits;
     if msb < lsb {
-        return Err(invalid(at, format!("bits = [{msb}, {lsb}]: msb is below lsb")));
+        return Err(invalid(
+            at,
+            format!("bits = [{msb}, {lsb}]: msb is below lsb"),
+        ));
     }
     if msb >= word_width {
         return Err(invalid(
@@ -318,7 +321,11 @@ fn check_bits(at: &str, bits: [u32; 2], word_width: u32) -> Result<(u32, u32), R
     Ok((msb, lsb))
 }
 
-fn check_unique<'a>(at: &str, kind: &str, names: impl Iterator<Item = &'a str>) -> Result<(), RegenError> {
+fn check_unique<'a>(
+    at: &str,
+    kind: &str,
+    names: impl Iterator<Item = &'a str>,
+) -> Result<(), RegenError> {
     let mut seen = BTreeSet::new();
     for name in names {
         if !seen.insert(name) {
@@ -336,14 +343,23 @@ fn resolve(raw: RawDescription) -> Result<Description, RegenError> {
     if b.window_size == 0 || b.window_size > 0x1_0000 || !b.window_size.is_power_of_two() {
         return Err(invalid(
             "block",
-            format!("window_size {:#x} must be a power of two up to 0x10000 (offsets are u16)", b.window_size),
+            format!(
+                "window_size {:#x} must be a power of two up to 0x10000 (offsets are u16)",
+                b.window_size
+            ),
         ));
     }
     if b.base_address % b.window_size != 0 {
-        return Err(invalid("block", "base_address must be aligned to window_size"));
+        return Err(invalid(
+            "block",
+            "base_address must be aligned to window_size",
+        ));
     }
     if b.version_major > 0xFF || b.version_minor > 0xFF {
-        return Err(invalid("block", "version_major and version_minor must fit in 8 bits"));
+        return Err(invalid(
+            "block",
+            "version_major and version_minor must fit in 8 bits",
+        ));
     }
     let block = Block {
         name: b.name,
@@ -357,7 +373,10 @@ fn resolve(raw: RawDescription) -> Result<Description, RegenError> {
     for name in raw.params.keys() {
         check_name(&format!("params.{name}"), &name.to_ascii_uppercase())?;
         if name.chars().any(|c| c.is_ascii_uppercase()) {
-            return Err(invalid(format!("params.{name}"), "parameter names are lower_snake_case"));
+            return Err(invalid(
+                format!("params.{name}"),
+                "parameter names are lower_snake_case",
+            ));
         }
     }
 
@@ -368,7 +387,11 @@ fn resolve(raw: RawDescription) -> Result<Description, RegenError> {
         registers.push(resolve_register(r, &block, &raw.params, &ports)?);
     }
     registers.sort_by_key(|r| r.offset);
-    check_unique("register", "register", registers.iter().map(|r| r.name.as_str()))?;
+    check_unique(
+        "register",
+        "register",
+        registers.iter().map(|r| r.name.as_str()),
+    )?;
     for pair in registers.windows(2) {
         if pair[0].offset == pair[1].offset {
             return Err(invalid(
@@ -394,7 +417,10 @@ fn check_version_register(registers: &[Register], block: &Block) -> Result<(), R
         .iter()
         .find(|r| r.name == "VERSION")
         .ok_or_else(|| invalid("register", "a VERSION register is required"))?;
-    for (name, want) in [("MAJOR", block.version_major), ("MINOR", block.version_minor)] {
+    for (name, want) in [
+        ("MAJOR", block.version_major),
+        ("MINOR", block.version_minor),
+    ] {
         let field = version
             .fields
             .iter()
@@ -403,20 +429,30 @@ fn check_version_register(registers: &[Register], block: &Block) -> Result<(), R
         if field.reset != want {
             return Err(invalid(
                 format!("register VERSION field {name}"),
-                format!("reset {} differs from block.version_{} = {want}", field.reset, name.to_ascii_lowercase()),
+                format!(
+                    "reset {} differs from block.version_{} = {want}",
+                    field.reset,
+                    name.to_ascii_lowercase()
+                ),
             ));
         }
     }
     Ok(())
 }
 
-fn resolve_bound(at: &str, bound: &RawBound, params: &BTreeMap<String, u32>) -> Result<u32, RegenError> {
+fn resolve_bound(
+    at: &str,
+    bound: &RawBound,
+    params: &BTreeMap<String, u32>,
+) -> Result<u32, RegenError> {
     match bound {
         RawBound::Value(v) => Ok(*v),
-        RawBound::Param(name) => params
-            .get(name)
-            .copied()
-            .ok_or_else(|| invalid(at, format!("range names `{name}`, which is not in [params]"))),
+        RawBound::Param(name) => params.get(name).copied().ok_or_else(|| {
+            invalid(
+                at,
+                format!("range names `{name}`, which is not in [params]"),
+            )
+        }),
     }
 }
 
@@ -429,18 +465,29 @@ fn resolve_register(
     let at = format!("register {}", r.name);
     check_name(&at, &r.name)?;
     if r.offset % 4 != 0 {
-        return Err(invalid(&at, format!("offset {:#x} is not 32-bit aligned", r.offset)));
+        return Err(invalid(
+            &at,
+            format!("offset {:#x} is not 32-bit aligned", r.offset),
+        ));
     }
     if r.offset + 4 > block.window_size {
-        return Err(invalid(&at, format!("offset {:#x} is outside the {:#x}-byte window", r.offset, block.window_size)));
+        return Err(invalid(
+            &at,
+            format!(
+                "offset {:#x} is outside the {:#x}-byte window",
+                r.offset, block.window_size
+            ),
+        ));
     }
 
     let mut fields = Vec::new();
     if let Some(port_name) = &r.fields_from_port {
-        let port = ports
-            .iter()
-            .find(|p| &p.name == port_name)
-            .ok_or_else(|| invalid(&at, format!("fields_from_port names `{port_name}`, which is not a port")))?;
+        let port = ports.iter().find(|p| &p.name == port_name).ok_or_else(|| {
+            invalid(
+                &at,
+                format!("fields_from_port names `{port_name}`, which is not a port"),
+            )
+        })?;
         for pf in &port.fields {
             fields.push(Field {
                 name: pf.name.clone(),
@@ -476,7 +523,10 @@ fn resolve_register(
     if composed != r.reset {
         return Err(invalid(
             &at,
-            format!("reset {:#010x} differs from its fields' resets, which compose to {composed:#010x}", r.reset),
+            format!(
+                "reset {:#010x} differs from its fields' resets, which compose to {composed:#010x}",
+                r.reset
+            ),
         ));
     }
     if r.pops_on_read && fields.iter().any(|f| f.access != Access::Ro) {
@@ -504,7 +554,10 @@ fn resolve_field(
     let (msb, lsb) = check_bits(&at, f.bits, 32)?;
     let max_value = bits_max(msb - lsb + 1);
     if f.reset > max_value {
-        return Err(invalid(&at, format!("reset {} does not fit in {} bits", f.reset, msb - lsb + 1)));
+        return Err(invalid(
+            &at,
+            format!("reset {} does not fit in {} bits", f.reset, msb - lsb + 1),
+        ));
     }
     let (min, max, has_range) = match &f.range {
         None => (0, max_value, false),
@@ -515,7 +568,10 @@ fn resolve_field(
                 return Err(invalid(&at, format!("range [{lo}, {hi}] is empty")));
             }
             if hi > max_value {
-                return Err(invalid(&at, format!("range maximum {hi} does not fit in {} bits", msb - lsb + 1)));
+                return Err(invalid(
+                    &at,
+                    format!("range maximum {hi} does not fit in {} bits", msb - lsb + 1),
+                ));
             }
             (lo, hi, true)
         }
@@ -523,14 +579,20 @@ fn resolve_field(
     let access = f.access.unwrap_or(default_access);
     // A ro field's reset is what the fabric shows before it writes; it need not be "valid".
     if access != Access::Ro && (f.reset < min || f.reset > max) {
-        return Err(invalid(&at, format!("reset {} is outside the range [{min}, {max}]", f.reset)));
+        return Err(invalid(
+            &at,
+            format!("reset {} is outside the range [{min}, {max}]", f.reset),
+        ));
     }
     let mut enums = Vec::with_capacity(f.enums.len());
     for e in f.enums {
         let eat = format!("{at} enum {}", e.name);
         check_name(&eat, &e.name)?;
         if e.value > max_value {
-            return Err(invalid(&eat, format!("value {} does not fit in the field", e.value)));
+            return Err(invalid(
+                &eat,
+                format!("value {} does not fit in the field", e.value),
+            ));
         }
         enums.push(EnumValue {
             name: e.name,
@@ -545,7 +607,10 @@ fn resolve_field(
         return Err(invalid(&at, "two enum names share a value"));
     }
     if !enums.is_empty() && !enums.iter().any(|e| e.value == f.reset) {
-        return Err(invalid(&at, format!("reset {} is none of the enum values", f.reset)));
+        return Err(invalid(
+            &at,
+            format!("reset {} is none of the enum values", f.reset),
+        ));
     }
     Ok(Field {
         name: f.name,
@@ -570,7 +635,10 @@ fn resolve_ports(raw: Vec<RawPort>) -> Result<Vec<Port>, RegenError> {
         for s in p.signals {
             check_name(&format!("{at} signal {}", s.name), &s.name)?;
             if s.width == 0 || s.width > 32 {
-                return Err(invalid(format!("{at} signal {}", s.name), "width must be 1..=32"));
+                return Err(invalid(
+                    format!("{at} signal {}", s.name),
+                    "width must be 1..=32",
+                ));
             }
             signals.push(Signal {
                 name: s.name,
@@ -599,7 +667,10 @@ fn resolve_ports(raw: Vec<RawPort>) -> Result<Vec<Port>, RegenError> {
         check_unique(&at, "field", fields.iter().map(|f| f.name.as_str()))?;
         for pair in fields.windows(2) {
             if pair[1].lsb <= pair[0].msb {
-                return Err(invalid(&at, format!("fields {} and {} overlap", pair[0].name, pair[1].name)));
+                return Err(invalid(
+                    &at,
+                    format!("fields {} and {} overlap", pair[0].name, pair[1].name),
+                ));
             }
         }
         ports.push(Port {
@@ -663,7 +734,9 @@ doc = "x"
 "#;
 
     fn error_of(source: &str) -> String {
-        parse(source).expect_err("description must be rejected").to_string()
+        parse(source)
+            .expect_err("description must be rejected")
+            .to_string()
     }
 
     #[test]
@@ -684,7 +757,10 @@ doc = "x"
     #[test]
     fn reset_must_compose_from_fields() {
         let e = error_of(&MINIMAL.replace("reset = 0x0102", "reset = 0x0103"));
-        assert!(e.contains("register VERSION") && e.contains("compose"), "{e}");
+        assert!(
+            e.contains("register VERSION") && e.contains("compose"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -11,7 +11,10 @@ pub enum RegenError {
     /// The description parsed but breaks a rule; `at` names the register/field/port.
     Invalid { at: String, what: String },
     /// Reading the description or writing an output failed.
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 impl fmt::Display for RegenError {

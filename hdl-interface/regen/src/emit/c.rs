@@ -16,18 +16,30 @@ pub fn emit(d: &Description) -> String {
     let _ = writeln!(o, "/* {BANNER}. */");
     let _ = writeln!(o, "/* Register map of `{}`: {} */", b.name, comment(&b.doc));
     o.push_str("#ifndef STEREOCAL_REGS_H\n#define STEREOCAL_REGS_H\n\n");
-    o.push_str("/* Offsets are bytes from STEREOCAL_BASE_ADDR; MASK macros are already shifted. */\n");
+    o.push_str(
+        "/* Offsets are bytes from STEREOCAL_BASE_ADDR; MASK macros are already shifted. */\n",
+    );
     let _ = writeln!(o, "#define STEREOCAL_BASE_ADDR 0x{:08X}u", b.base_address);
     let _ = writeln!(o, "#define STEREOCAL_WINDOW_SIZE 0x{:X}u", b.window_size);
     let _ = writeln!(o, "#define STEREOCAL_REGISTER_WIDTH {}u", b.register_width);
     let _ = writeln!(o, "#define STEREOCAL_VERSION_MAJOR {}u", b.version_major);
     let _ = writeln!(o, "#define STEREOCAL_VERSION_MINOR {}u", b.version_minor);
     for (name, value) in &d.params {
-        let _ = writeln!(o, "#define STEREOCAL_{} {value}u", name.to_ascii_uppercase());
+        let _ = writeln!(
+            o,
+            "#define STEREOCAL_{} {value}u",
+            name.to_ascii_uppercase()
+        );
     }
     for r in &d.registers {
         o.push('\n');
-        let _ = writeln!(o, "/* {} ({}): {} */", r.name, r.access.as_str(), comment(&r.doc));
+        let _ = writeln!(
+            o,
+            "/* {} ({}): {} */",
+            r.name,
+            r.access.as_str(),
+            comment(&r.doc)
+        );
         let p = format!("STEREOCAL_{}", r.name);
         let _ = writeln!(o, "#define {p}_OFFSET 0x{:02X}u", r.offset);
         let _ = writeln!(o, "#define {p}_RESET 0x{:08X}u", r.reset);
@@ -55,13 +67,25 @@ pub fn emit(d: &Description) -> String {
                 let _ = writeln!(o, "#define {fp}_MAX {}u", f.max);
             }
             for e in &f.enums {
-                let _ = writeln!(o, "#define {fp}_{} {}u /* {} */", e.name, e.value, comment(&e.doc));
+                let _ = writeln!(
+                    o,
+                    "#define {fp}_{} {}u /* {} */",
+                    e.name,
+                    e.value,
+                    comment(&e.doc)
+                );
             }
         }
     }
     for port in &d.ports {
         o.push('\n');
-        let _ = writeln!(o, "/* Stream port {} ({}): {} */", port.name, port.direction.as_str(), comment(&port.doc));
+        let _ = writeln!(
+            o,
+            "/* Stream port {} ({}): {} */",
+            port.name,
+            port.direction.as_str(),
+            comment(&port.doc)
+        );
         let p = format!("STEREOCAL_PORT_{}", port.name);
         for s in &port.signals {
             let _ = writeln!(o, "#define {p}_{}_WIDTH {}u", s.name, s.width);

@@ -27,8 +27,10 @@ pub fn emit(d: &Description) -> String {
         b.version_major,
         b.version_minor
     );
-    o.push_str("Access: `ro` the bus cannot write it; `rw` reads back what was written; \
-                `w1c` set by the fabric, cleared by writing 1; `wo` a strobe that reads 0.\n\n");
+    o.push_str(
+        "Access: `ro` the bus cannot write it; `rw` reads back what was written; \
+                `w1c` set by the fabric, cleared by writing 1; `wo` a strobe that reads 0.\n\n",
+    );
 
     o.push_str("## Parameters\n\n| Parameter | Value |\n|---|---|\n");
     for (name, value) in &d.params {
@@ -64,7 +66,9 @@ pub fn emit(d: &Description) -> String {
             hex32_grouped(r.reset),
             r.doc
         );
-        o.push_str("| Bits | Field | Access | Reset | Valid | Description |\n|---|---|---|---|---|---|\n");
+        o.push_str(
+            "| Bits | Field | Access | Reset | Valid | Description |\n|---|---|---|---|---|---|\n",
+        );
         for f in r.fields.iter().rev() {
             let bits = if f.msb == f.lsb {
                 format!("{}", f.lsb)

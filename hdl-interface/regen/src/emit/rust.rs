@@ -40,18 +40,37 @@ pub fn emit(d: &Description) -> String {
     let _ = writeln!(o, "// {BANNER}.");
     let _ = writeln!(o, "//! Register map of `{}`: {}", b.name, b.doc);
     let _ = writeln!(o, "//!");
-    let _ = writeln!(o, "//! One module per register (byte offset, reset value, one [`Field`] per field, enums),");
-    let _ = writeln!(o, "//! [`REGISTERS`] for table-driven code, and [`ports`] for the stream-port layouts.");
+    let _ = writeln!(
+        o,
+        "//! One module per register (byte offset, reset value, one [`Field`] per field, enums),"
+    );
+    let _ = writeln!(
+        o,
+        "//! [`REGISTERS`] for table-driven code, and [`ports`] for the stream-port layouts."
+    );
     o.push_str("#![allow(clippy::unusual_byte_groupings)]\n\n");
     o.push_str("#[allow(unused_imports)]\nuse crate::{Access, BitRange, Field, Register};\n\n");
 
-    let _ = writeln!(o, "/// Address of the fabric's AXI4-lite register window on the soft-core's bus.");
-    let _ = writeln!(o, "pub const BASE_ADDRESS: usize = {};", hex32_grouped(b.base_address));
-    let _ = writeln!(o, "/// Bytes in the register window; every offset is below it.");
+    let _ = writeln!(
+        o,
+        "/// Address of the fabric's AXI4-lite register window on the soft-core's bus."
+    );
+    let _ = writeln!(
+        o,
+        "pub const BASE_ADDRESS: usize = {};",
+        hex32_grouped(b.base_address)
+    );
+    let _ = writeln!(
+        o,
+        "/// Bytes in the register window; every offset is below it."
+    );
     let _ = writeln!(o, "pub const WINDOW_SIZE: u32 = {:#X};", b.window_size);
     let _ = writeln!(o, "/// Bits per register.");
     let _ = writeln!(o, "pub const REGISTER_WIDTH: u32 = {};", b.register_width);
-    let _ = writeln!(o, "/// Register-map version this crate was generated for (VERSION.MAJOR / VERSION.MINOR).");
+    let _ = writeln!(
+        o,
+        "/// Register-map version this crate was generated for (VERSION.MAJOR / VERSION.MINOR)."
+    );
     let _ = writeln!(o, "pub const VERSION_MAJOR: u32 = {};", b.version_major);
     let _ = writeln!(o, "pub const VERSION_MINOR: u32 = {};", b.version_minor);
     for (name, value) in &d.params {
@@ -65,7 +84,11 @@ pub fn emit(d: &Description) -> String {
     }
 
     let _ = writeln!(o, "/// Every register, sorted by offset.");
-    let _ = writeln!(o, "pub static REGISTERS: [Register; {}] = [", d.registers.len());
+    let _ = writeln!(
+        o,
+        "pub static REGISTERS: [Register; {}] = [",
+        d.registers.len()
+    );
     for r in &d.registers {
         let _ = writeln!(o, "    {}::REGISTER,", r.name.to_ascii_lowercase());
     }
@@ -76,15 +99,39 @@ pub fn emit(d: &Description) -> String {
     o.push_str("    #[allow(unused_imports)]\n    use crate::BitRange;\n");
     for p in &d.ports {
         o.push('\n');
-        doc_lines(&mut o, "    ", &format!("{} Direction: {} of the fabric.", p.doc, p.direction.as_str()));
+        doc_lines(
+            &mut o,
+            "    ",
+            &format!(
+                "{} Direction: {} of the fabric.",
+                p.doc,
+                p.direction.as_str()
+            ),
+        );
         let _ = writeln!(o, "    pub mod {} {{", p.name.to_ascii_lowercase());
-        let _ = writeln!(o, "        #[allow(unused_imports)]\n        use super::BitRange;\n");
+        let _ = writeln!(
+            o,
+            "        #[allow(unused_imports)]\n        use super::BitRange;\n"
+        );
         for s in &p.signals {
-            doc_lines(&mut o, "        ", &format!("Width of `{}` ({}): {}", s.name, s.direction.as_str(), s.doc));
+            doc_lines(
+                &mut o,
+                "        ",
+                &format!(
+                    "Width of `{}` ({}): {}",
+                    s.name,
+                    s.direction.as_str(),
+                    s.doc
+                ),
+            );
             let _ = writeln!(o, "        pub const {}_WIDTH: u32 = {};", s.name, s.width);
         }
         for f in &p.fields {
-            doc_lines(&mut o, "        ", &format!("DATA[{}:{}]: {}", f.msb, f.lsb, f.doc));
+            doc_lines(
+                &mut o,
+                "        ",
+                &format!("`DATA[{}:{}]`: {}", f.msb, f.lsb, f.doc),
+            );
             let _ = writeln!(
                 o,
                 "        pub const {}: BitRange = BitRange {{ lsb: {}, width: {} }};",
@@ -100,9 +147,15 @@ pub fn emit(d: &Description) -> String {
 }
 
 fn emit_register(o: &mut String, r: &Register) {
-    doc_lines(o, "", &format!("{} Offset {:#04X}, {}.", r.doc, r.offset, r.access.as_str()));
+    doc_lines(
+        o,
+        "",
+        &format!("{} Offset {:#04X}, {}.", r.doc, r.offset, r.access.as_str()),
+    );
     let _ = writeln!(o, "pub mod {} {{", r.name.to_ascii_lowercase());
-    o.push_str("    #[allow(unused_imports)]\n    use super::{Access, BitRange, Field, Register};\n\n");
+    o.push_str(
+        "    #[allow(unused_imports)]\n    use super::{Access, BitRange, Field, Register};\n\n",
+    );
     let _ = writeln!(o, "    /// Byte offset from [`super::BASE_ADDRESS`].");
     let _ = writeln!(o, "    pub const OFFSET: u16 = {:#04X};", r.offset);
     let _ = writeln!(o, "    /// Value after reset.");
@@ -138,7 +191,7 @@ fn emit_field(o: &mut String, r: &Register, f: &Field) {
         o,
         "    ",
         &format!(
-            "[{}:{}] {}, reset {}{range}: {}",
+            "`[{}:{}]` {}, reset {}{range}: {}",
             f.msb,
             f.lsb,
             f.access.as_str(),
@@ -149,7 +202,12 @@ fn emit_field(o: &mut String, r: &Register, f: &Field) {
     let _ = writeln!(o, "    pub const {}: Field = Field {{", f.name);
     let _ = writeln!(o, "        name: \"{}.{}\",", r.name, f.name);
     o.push_str("        offset: OFFSET,\n");
-    let _ = writeln!(o, "        bits: BitRange {{ lsb: {}, width: {} }},", f.lsb, f.width());
+    let _ = writeln!(
+        o,
+        "        bits: BitRange {{ lsb: {}, width: {} }},",
+        f.lsb,
+        f.width()
+    );
     let _ = writeln!(o, "        access: {},", access_variant(f.access));
     let _ = writeln!(o, "        reset: {},", f.reset);
     let _ = writeln!(o, "        min: {},", f.min);
@@ -172,9 +230,16 @@ fn emit_field(o: &mut String, r: &Register, f: &Field) {
     o.push_str("        /// The field's code for this value.\n");
     o.push_str("        pub const fn bits(self) -> u32 {\n            self as u32\n        }\n\n");
     o.push_str("        /// The value a code names, if any.\n");
-    o.push_str("        pub const fn from_bits(bits: u32) -> Option<Self> {\n            match bits {\n");
+    o.push_str(
+        "        pub const fn from_bits(bits: u32) -> Option<Self> {\n            match bits {\n",
+    );
     for e in &f.enums {
-        let _ = writeln!(o, "                {} => Some(Self::{}),", e.value, camel_case(&e.name));
+        let _ = writeln!(
+            o,
+            "                {} => Some(Self::{}),",
+            e.value,
+            camel_case(&e.name)
+        );
     }
     o.push_str("                _ => None,\n            }\n        }\n    }\n\n");
     let reset = f
