@@ -1,0 +1,119 @@
+//! A streaming receiver: bytes in, decoded packets out, at any chunking of the input.
+
+use crate::frame::{decode, DELIMITER};
+use crate::packet::header::Header;
+use crate::packet_repr::PacketRepr;
+use crate::Error;
+
+/// Collects the bytes of one COBS frame in a buffer of `N` bytes and decodes it when its
+/// `0x00` arrives.
+///
+/// `N` must be at least [`MAX_FRAME_LEN`](crate::MAX_FRAME_LEN)` - 1` to receive every packet
+/// kind; a smaller `N` suits a receiver that only expects short packets. A frame longer than
+/// `N` is reported once as [`FeedResult::OverFull`] and skipped up to its delimiter, so the
+/// next frame decodes normally. Empty frames (`0x00 0x00`) are ignored: a sender may send a
+/// lone `0x00` to flush a receiver's partial frame.
+#[derive(Debug, Clone)]
+pub struct Accumulator<const N: usize> {
+    buf: [u8; N],
+    len: usize,
+    /// Skipping the rest of an over-long frame.
+    discarding: bool,
+}
+
+/// What [`Accumulator::feed`] found. `'de` borrows the accumulator, `'a` the input.
+#[derive(Debug)]
+pub enum FeedResult<'de, 'a> {
+    /// All input was consumed without completing a frame.
+    Consumed,
+    /// A frame was longer than the buffer and is dropped; feed the remaining input again.
+    OverFull(&'a [u8]),
+    /// A complete frame failed to decode; feed the remaining input again.
+    DecodeError {
+        /// What was wrong with the frame.
+        error: Error,
+        /// Input after the bad frame's delimiter.
+        remaining: &'a [u8],
+    },
+    /// A frame decoded; feed the remaining input again.
+    Success {
+        /// The packet's header.
+        header: Header,
+        /// The packet's payload, borrowing the accumulator's buffer.
+        packet: PacketRepr<'de>,
+        /// Input after the frame's delimiter.
+        remaining: &'a [u8],
+    },
+}
+
+impl<const N: usize> Accumulator<N> {
+    /// An empty accumulator.
+    pub const fn new() -> Self {
+        Accumulator {
+            buf: [0; N],
+            len: 0,
+            discarding: false,
+        }
+    }
+
+    /// Drops any partial frame (e.g. after reopening the link).
+    pub fn reset(&mut self) {
+        self.len = 0;
+        self.discarding = false;
+    }
+
+    /// Takes input up to and including the first frame delimiter that completes a frame, and
+    /// reports what happened; call again with the remaining input until [`FeedResult::Consumed`].
+    /// Never panics, whatever the input.
+    pub fn feed<'de, 'a>(&'de mut self, input: &'a [u8]) -> FeedResult<'de, 'a> {
+        let mut input = input;
+        loop {
+            let (chunk, delimited, rest) = match input.iter().position(|&byte| byte == DELIMITER) {
+                Some(at) => (&input[..at], true, &input[at + 1..]),
+                None => (input, false, &input[input.len()..]),
+            };
+            if self.discarding {
+                if !delimited {
+                    return FeedResult::Consumed;
+                }
+                self.discarding = false;
+                input = rest;
+                continue;
+            }
+            let room = N - self.len;
+            if chunk.len() > room {
+                self.len = 0;
+                self.discarding = !delimited;
+                return FeedResult::OverFull(rest);
+            }
+            self.buf[self.len..self.len + chunk.len()].copy_from_slice(chunk);
+            self.len += chunk.len();
+            if !delimited {
+                return FeedResult::Consumed;
+            }
+            let frame_len = self.len;
+            self.len = 0;
+            if frame_len == 0 {
+                input = rest;
+                continue;
+            }
+            return match decode(&mut self.buf[..frame_len]) {
+                Ok((header, packet)) => FeedResult::Success {
+                    header,
+                    packet,
+                    remaining: rest,
+                },
+                Err(error) => FeedResult::DecodeError {
+                    error,
+                    remaining: rest,
+                },
+            };
+        }
+    }
+}
+
+impl<const N: usize> Default for Accumulator<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}

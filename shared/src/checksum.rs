@@ -1,0 +1,25 @@
+//! The packet checksum: CRC-32C (Castagnoli), as used by iSCSI, SCTP and ext4.
+//!
+//! Parameters (Rocksoft model): width 32, poly `0x1EDC6F41`, init `0xFFFFFFFF`, refin true,
+//! refout true, xorout `0xFFFFFFFF`, check (`"123456789"`) `0xE3069283`. Chosen over
+//! CRC-32/ISO-HDLC for its larger Hamming distance at our packet lengths; the table-driven
+//! `crc` implementation costs 1 KiB of read-only table on the soft-core.
+
+use crc::{Crc, CRC_32_ISCSI};
+
+static CRC32C: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
+
+/// CRC-32C of `bytes`.
+pub fn crc32c(bytes: &[u8]) -> u32 {
+    CRC32C.checksum(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_value_matches_the_catalogue() {
+        assert_eq!(crc32c(b"123456789"), 0xE306_9283);
+    }
+}

@@ -1,0 +1,163 @@
+//! The whole packet: a 6-byte header, the payload, and a CRC-32C trailer.
+//!
+//! ```text
+//!  0        1        2        4              6                6+n        10+n
+//! +--------+--------+--------+--------------+-- ... --+------------------+
+//! |version |  kind  |  seq   | payload len n| payload |  CRC-32C (LE)    |
+//! |   u8   |   u8   | u16 LE |    u16 LE    | n bytes | over bytes 0..6+n|
+//! +--------+--------+--------+--------------+-- ... --+------------------+
+//! ```
+
+use crate::checksum::crc32c;
+use crate::le::{self, Field};
+use crate::packet::check_room;
+use crate::packet::kind::PacketKind;
+use crate::Error;
+
+mod field {
+    use super::Field;
+    pub const VERSION: usize = 0;
+    pub const KIND: usize = 1;
+    pub const SEQ: Field = 2..4;
+    pub const PAYLOAD_LEN: Field = 4..6;
+    pub const PAYLOAD: usize = 6;
+}
+
+/// Bytes before the payload.
+pub const HEADER_LEN: usize = field::PAYLOAD;
+/// Bytes of the CRC trailer.
+pub const CRC_LEN: usize = 4;
+
+packet_view! {
+    /// A view over a whole packet (header, payload, CRC), before COBS framing.
+}
+
+impl<T: AsRef<[u8]>> Packet<T> {
+    /// Checks that the buffer holds the header, exactly `payload_len` payload bytes, and the CRC.
+    pub fn check_len(&self) -> Result<(), Error> {
+        let len = self.buffer.as_ref().len();
+        if len < HEADER_LEN + CRC_LEN {
+            return Err(Error::DecodeUnexpectedEnd);
+        }
+        let needed = HEADER_LEN + usize::from(self.payload_len()) + CRC_LEN;
+        super::check_fixed_len(len, needed)
+    }
+
+    /// Protocol version of the sender.
+    pub fn version(&self) -> u8 {
+        self.buffer.as_ref()[field::VERSION]
+    }
+
+    /// Packet kind.
+    pub fn kind(&self) -> PacketKind {
+        PacketKind::from(self.buffer.as_ref()[field::KIND])
+    }
+
+    /// Sequence number; the sender increments it (wrapping) per packet, so gaps show loss.
+    pub fn seq(&self) -> u16 {
+        le::read_u16(self.buffer.as_ref(), field::SEQ)
+    }
+
+    /// Payload length in bytes.
+    pub fn payload_len(&self) -> u16 {
+        le::read_u16(self.buffer.as_ref(), field::PAYLOAD_LEN)
+    }
+
+    /// The payload bytes.
+    pub fn payload(&self) -> &[u8] {
+        let data = self.buffer.as_ref();
+        &data[field::PAYLOAD..data.len() - CRC_LEN]
+    }
+
+    /// The CRC stored in the trailer.
+    pub fn crc(&self) -> u32 {
+        let data = self.buffer.as_ref();
+        le::read_u32(data, data.len() - CRC_LEN..data.len())
+    }
+
+    /// `true` when the trailer matches the CRC-32C of everything before it.
+    pub fn verify_crc(&self) -> bool {
+        let data = self.buffer.as_ref();
+        crc32c(&data[..data.len() - CRC_LEN]) == self.crc()
+    }
+}
+
+impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
+    /// Sets the protocol version.
+    pub fn set_version(&mut self, value: u8) {
+        self.buffer.as_mut()[field::VERSION] = value;
+    }
+
+    /// Sets the packet kind.
+    pub fn set_kind(&mut self, value: PacketKind) {
+        self.buffer.as_mut()[field::KIND] = u8::from(value);
+    }
+
+    /// Sets the sequence number.
+    pub fn set_seq(&mut self, value: u16) {
+        le::write_u16(self.buffer.as_mut(), field::SEQ, value);
+    }
+
+    /// Sets the payload length.
+    pub fn set_payload_len(&mut self, value: u16) {
+        le::write_u16(self.buffer.as_mut(), field::PAYLOAD_LEN, value);
+    }
+
+    /// The payload bytes, for a payload view to emit into.
+    pub fn payload_mut(&mut self) -> &mut [u8] {
+        let data = self.buffer.as_mut();
+        let end = data.len() - CRC_LEN;
+        &mut data[field::PAYLOAD..end]
+    }
+
+    /// Computes the CRC over header and payload and stores it in the trailer.
+    pub fn fill_crc(&mut self) {
+        let data = self.buffer.as_mut();
+        let end = data.len() - CRC_LEN;
+        let crc = crc32c(&data[..end]);
+        le::write_u32(data, end..data.len(), crc);
+    }
+}
+
+/// The parsed header of a packet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Header {
+    /// Protocol version of the sender.
+    pub version: u8,
+    /// Packet kind.
+    pub kind: PacketKind,
+    /// Sequence number.
+    pub seq: u16,
+    /// Payload length in bytes.
+    pub payload_len: u16,
+}
+
+impl Header {
+    /// Reads the header of a checked packet (the CRC and version are checked by
+    /// [`decode`](crate::decode), not here).
+    pub fn parse<T: AsRef<[u8]> + ?Sized>(packet: &Packet<&T>) -> Result<Header, Error> {
+        packet.check_len()?;
+        Ok(Header {
+            version: packet.version(),
+            kind: packet.kind(),
+            seq: packet.seq(),
+            payload_len: packet.payload_len(),
+        })
+    }
+
+    /// Bytes of the whole packet: header, payload and CRC.
+    pub fn buffer_len(&self) -> usize {
+        HEADER_LEN + usize::from(self.payload_len) + CRC_LEN
+    }
+
+    /// Writes the header fields (not the payload or the CRC).
+    pub fn emit<T: AsRef<[u8]> + AsMut<[u8]>>(&self, packet: &mut Packet<T>) -> Result<(), Error> {
+        check_room(packet.buffer.as_ref().len(), self.buffer_len())?;
+        packet.set_version(self.version);
+        packet.set_kind(self.kind);
+        packet.set_seq(self.seq);
+        packet.set_payload_len(self.payload_len);
+        Ok(())
+    }
+}
