@@ -295,3 +295,44 @@ mod tests {
         assert_eq!(bank, RegisterBank::new());
     }
 }
+
+#[cfg(test)]
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Whatever the fabric set and whatever the bus writes, each bit follows its access type.
+        #[test]
+        fn bus_writes_follow_the_access_masks(
+            index in 0..regs::REGISTERS.len(),
+            device in any::<u32>(),
+            written in any::<u32>(),
+        ) {
+            let r = &regs::REGISTERS[index];
+            let mut bank = RegisterBank::new();
+            bank.device_write(r.offset, device).unwrap();
+            let before = bank.device_read(r.offset).unwrap();
+            bank.try_write(r.offset, written).unwrap();
+            let after = bank.device_read(r.offset).unwrap();
+            prop_assert_eq!(after & r.ro_mask, before & r.ro_mask);
+            prop_assert_eq!(after & r.rw_mask, written & r.rw_mask);
+            prop_assert_eq!(after & r.wo_mask, written & r.wo_mask);
+            prop_assert_eq!(after & r.w1c_mask, before & r.w1c_mask & !written);
+            prop_assert_eq!(after & !r.defined_mask(), 0);
+            prop_assert_eq!(bank.try_read(r.offset).unwrap(), after & !r.wo_mask);
+        }
+
+        /// No offset makes the bank panic; only mapped, aligned offsets succeed.
+        #[test]
+        fn any_offset_is_answered(offset in any::<u16>(), value in any::<u32>()) {
+            let mut bank = RegisterBank::new();
+            let mapped = crate::register_at(offset).is_some();
+            prop_assert_eq!(bank.try_write(offset, value).is_ok(), mapped);
+            prop_assert_eq!(bank.try_read(offset).is_ok(), mapped);
+            bank.write(offset, value);
+            let _ = bank.read(offset);
+            prop_assert_eq!(bank.bus_errors(), if mapped { 0 } else { 2 });
+        }
+    }
+}

@@ -54,3 +54,68 @@ impl<B: RegisterBus + ?Sized> RegisterBus for &mut B {
         (**self).write(offset, value)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::regs::{control, status};
+
+    /// Registers where every bit reads back as written, and a log of the accesses.
+    struct Recorder {
+        value: u32,
+        reads: usize,
+        writes: [Option<(u16, u32)>; 4],
+        count: usize,
+    }
+
+    impl RegisterBus for Recorder {
+        fn read(&mut self, _offset: u16) -> u32 {
+            self.reads += 1;
+            self.value
+        }
+
+        fn write(&mut self, offset: u16, value: u32) {
+            self.writes[self.count] = Some((offset, value));
+            self.count += 1;
+        }
+    }
+
+    fn recorder(value: u32) -> Recorder {
+        Recorder {
+            value,
+            reads: 0,
+            writes: [None; 4],
+            count: 0,
+        }
+    }
+
+    #[test]
+    fn clearing_a_flag_neither_reads_nor_clears_the_other_flags() {
+        let mut bus = recorder(0xF);
+        bus.write_field(&status::SOBEL_OVERFLOW, 1).unwrap();
+        assert_eq!(bus.reads, 0);
+        assert_eq!(
+            bus.writes[0],
+            Some((status::OFFSET, status::SOBEL_OVERFLOW.mask()))
+        );
+    }
+
+    #[test]
+    fn firing_a_strobe_keeps_rw_bits_and_fires_no_other_strobe() {
+        // As if the bus returned every bit set (a wo bit must still be written as 0).
+        let mut bus = recorder(u32::MAX);
+        // Through `&mut Recorder`, the form a driver generic over `B: RegisterBus` receives.
+        fn fire<B: RegisterBus>(mut bus: B) -> Result<(), Error> {
+            bus.write_field(&control::FRAME_ARM, 1)
+        }
+        fire(&mut bus).unwrap();
+        assert_eq!(bus.reads, 1);
+        assert_eq!(
+            bus.writes[0],
+            Some((
+                control::OFFSET,
+                control::ENABLE.mask() | control::FRAME_ARM.mask()
+            ))
+        );
+    }
+}

@@ -402,12 +402,111 @@ fn resolve(raw: RawDescription) -> Result<Description, RegenError> {
     }
     check_version_register(&registers, &block)?;
 
-    Ok(Description {
+    let d = Description {
         block,
         params: raw.params.into_iter().collect(),
         registers,
         ports,
-    })
+    };
+    check_generated_names(&d)?;
+    Ok(d)
+}
+
+/// The emitters flatten names (`REGISTER_FIELD_MASK` in C and Verilog, `FIELD` next to
+/// `OFFSET` in a Rust module), so distinct entries can meet in one identifier: register `A_B`
+/// field `C` and register `A` field `B_C`, or a field called `OFFSET`. Every identifier each
+/// emitter derives is listed here with the entry it comes from; a repeat is an error naming
+/// both entries.
+fn check_generated_names(d: &Description) -> Result<(), RegenError> {
+    let mut flat: BTreeMap<String, String> = BTreeMap::new();
+    let mut claim = |scope: &str, name: String, origin: String| -> Result<(), RegenError> {
+        match flat.insert(format!("{scope}{name}"), origin.clone()) {
+            Some(previous) if previous != origin => Err(invalid(
+                origin,
+                format!("generates the identifier `{name}`, which {previous} also generates"),
+            )),
+            _ => Ok(()),
+        }
+    };
+    for name in [
+        "BASE_ADDR",
+        "BASE_ADDRESS",
+        "WINDOW_SIZE",
+        "OFFSET_BITS",
+        "REGISTER_WIDTH",
+        "VERSION_MAJOR",
+        "VERSION_MINOR",
+        "REGISTERS",
+        "PORTS",
+    ] {
+        claim("", name.to_string(), "block".to_string())?;
+    }
+    for (name, _) in &d.params {
+        claim("", name.to_ascii_uppercase(), format!("params.{name}"))?;
+    }
+    for r in &d.registers {
+        let origin = format!("register {}", r.name);
+        // The Rust module name, and the C/Verilog macros.
+        claim("", r.name.clone(), origin.clone())?;
+        for suffix in ["OFFSET", "RESET"] {
+            claim("", format!("{}_{suffix}", r.name), origin.clone())?;
+        }
+        let module = format!("{}::", r.name);
+        for name in ["OFFSET", "RESET", "REGISTER"] {
+            claim(&module, name.to_string(), origin.clone())?;
+        }
+        for f in &r.fields {
+            let origin = format!("register {} field {}", r.name, f.name);
+            claim(&module, f.name.clone(), origin.clone())?;
+            if !f.enums.is_empty() {
+                claim(&module, format!("{}_RESET", f.name), origin.clone())?;
+            }
+            for suffix in [
+                "SHIFT", "LSB", "MSB", "WIDTH", "MASK", "RESET", "MIN", "MAX",
+            ] {
+                claim(
+                    "",
+                    format!("{}_{}_{suffix}", r.name, f.name),
+                    origin.clone(),
+                )?;
+            }
+            for e in &f.enums {
+                claim(
+                    "",
+                    format!("{}_{}_{}", r.name, f.name, e.name),
+                    format!("{origin} enum {}", e.name),
+                )?;
+            }
+        }
+    }
+    for p in &d.ports {
+        let origin = format!("port {}", p.name);
+        let module = format!("ports::{}::", p.name);
+        for s in &p.signals {
+            claim(
+                "",
+                format!("{}_{}_WIDTH", p.name, s.name),
+                format!("{origin} signal {}", s.name),
+            )?;
+            claim(
+                &module,
+                format!("{}_WIDTH", s.name),
+                format!("{origin} signal {}", s.name),
+            )?;
+        }
+        for f in &p.fields {
+            let forigin = format!("{origin} field {}", f.name);
+            claim(&module, f.name.clone(), forigin.clone())?;
+            for suffix in ["LSB", "MSB", "WIDTH"] {
+                claim(
+                    "",
+                    format!("{}_{}_{suffix}", p.name, f.name),
+                    forigin.clone(),
+                )?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// VERSION's MAJOR/MINOR resets must be the block's version, so the map's version lives in one
@@ -785,6 +884,15 @@ doc = "x"
     fn reset_outside_range_is_rejected() {
         let e = error_of(&MINIMAL.replace("reset = 50", "reset = 500"));
         assert!(e.contains("register WIDTH"), "{e}");
+    }
+
+    #[test]
+    fn colliding_generated_identifiers_are_rejected() {
+        let e = error_of(&MINIMAL.replace("name = \"VALUE\"", "name = \"OFFSET\""));
+        assert!(e.contains("`OFFSET`"), "{e}");
+        let split = MINIMAL.replace("name = \"WIDTH\"", "name = \"VERSION_MAJOR\"");
+        let e = error_of(&split);
+        assert!(e.contains("VERSION_MAJOR"), "{e}");
     }
 
     #[test]
