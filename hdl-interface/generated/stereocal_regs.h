@@ -139,8 +139,8 @@
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_WIDTH 1u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_MASK 0x00000001u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_RESET 0x1u
-#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_ROWS 0u /* Every pixel of the selected scale of octave 1, in raster order (FIRST marks each line start). */
-#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES 1u /* Only the 16x16 patch around each point, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start). */
+#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_ROWS 0u /* Every pixel of the selected scale of octave 0 (full resolution), in raster order (FIRST marks each line start). */
+#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES 1u /* Only the 16x16 patch around each point, taken from the selected scale of the point's own octave, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start). */
 /* [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit. */
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_SHIFT 4u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_WIDTH 2u
@@ -207,7 +207,7 @@
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_MASK 0xFFFFFFFFu
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_RESET 0x0u
 
-/* POINT_FIFO_DATA (ro): Head of the point FIFO; a read removes it. Layout of POINT_OUT's DATA plus VALID. */
+/* POINT_FIFO_DATA (ro): Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID. */
 #define STEREOCAL_POINT_FIFO_DATA_OFFSET 0x3Cu
 #define STEREOCAL_POINT_FIFO_DATA_RESET 0x00000000u
 /* [10:0] ro: Column in the point's own octave (full-resolution column = X << (OCTAVE)). */
@@ -225,7 +225,7 @@
 #define STEREOCAL_POINT_FIFO_DATA_OCTAVE_WIDTH 2u
 #define STEREOCAL_POINT_FIFO_DATA_OCTAVE_MASK 0x00C00000u
 #define STEREOCAL_POINT_FIFO_DATA_OCTAVE_RESET 0x0u
-/* [25:24] ro: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below). */
+/* [25:24] ro: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves. */
 #define STEREOCAL_POINT_FIFO_DATA_SCALE_SHIFT 24u
 #define STEREOCAL_POINT_FIFO_DATA_SCALE_WIDTH 2u
 #define STEREOCAL_POINT_FIFO_DATA_SCALE_MASK 0x03000000u
@@ -241,7 +241,7 @@
 #define STEREOCAL_POINT_FIFO_DATA_VALID_MASK 0x80000000u
 #define STEREOCAL_POINT_FIFO_DATA_VALID_RESET 0x0u
 
-/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO; a read removes it. Layout of SOBEL_OUT's DATA plus VALID. */
+/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID. */
 #define STEREOCAL_SOBEL_FIFO_DATA_OFFSET 0x40u
 #define STEREOCAL_SOBEL_FIFO_DATA_RESET 0x00000000u
 /* [7:0] ro: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits. */

@@ -147,8 +147,8 @@ localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_MSB = 0;
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_WIDTH = 1;
 localparam [31:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_MASK = 32'h00000001;
 localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_RESET = 1'h1;
-localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_ROWS = 1'd0; // Every pixel of the selected scale of octave 1, in raster order (FIRST marks each line start).
-localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES = 1'd1; // Only the 16x16 patch around each point, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start).
+localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_ROWS = 1'd0; // Every pixel of the selected scale of octave 0 (full resolution), in raster order (FIRST marks each line start).
+localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES = 1'd1; // Only the 16x16 patch around each point, taken from the selected scale of the point's own octave, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start).
 // [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit.
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_LSB = 4;
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_MSB = 5;
@@ -216,7 +216,7 @@ localparam integer SC_LATENCY_CLOCKS_CLOCKS_WIDTH = 32;
 localparam [31:0] SC_LATENCY_CLOCKS_CLOCKS_MASK = 32'hFFFFFFFF;
 localparam [31:0] SC_LATENCY_CLOCKS_CLOCKS_RESET = 32'h0;
 
-// POINT_FIFO_DATA (ro, read pops): Head of the point FIFO; a read removes it. Layout of POINT_OUT's DATA plus VALID.
+// POINT_FIFO_DATA (ro, read pops): Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID.
 localparam [7:0] SC_POINT_FIFO_DATA_OFFSET = 8'h3C;
 localparam [31:0] SC_POINT_FIFO_DATA_RESET = 32'h00000000;
 // [10:0] ro: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
@@ -237,7 +237,7 @@ localparam integer SC_POINT_FIFO_DATA_OCTAVE_MSB = 23;
 localparam integer SC_POINT_FIFO_DATA_OCTAVE_WIDTH = 2;
 localparam [31:0] SC_POINT_FIFO_DATA_OCTAVE_MASK = 32'h00C00000;
 localparam [1:0] SC_POINT_FIFO_DATA_OCTAVE_RESET = 2'h0;
-// [25:24] ro: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
+// [25:24] ro: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
 localparam integer SC_POINT_FIFO_DATA_SCALE_LSB = 24;
 localparam integer SC_POINT_FIFO_DATA_SCALE_MSB = 25;
 localparam integer SC_POINT_FIFO_DATA_SCALE_WIDTH = 2;
@@ -256,7 +256,7 @@ localparam integer SC_POINT_FIFO_DATA_VALID_WIDTH = 1;
 localparam [31:0] SC_POINT_FIFO_DATA_VALID_MASK = 32'h80000000;
 localparam [0:0] SC_POINT_FIFO_DATA_VALID_RESET = 1'h0;
 
-// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO; a read removes it. Layout of SOBEL_OUT's DATA plus VALID.
+// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID.
 localparam [7:0] SC_SOBEL_FIFO_DATA_OFFSET = 8'h40;
 localparam [31:0] SC_SOBEL_FIFO_DATA_RESET = 32'h00000000;
 // [7:0] ro: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
@@ -307,7 +307,7 @@ localparam integer SC_POINT_OUT_Y_WIDTH = 11;
 localparam integer SC_POINT_OUT_OCTAVE_LSB = 22;
 localparam integer SC_POINT_OUT_OCTAVE_MSB = 23;
 localparam integer SC_POINT_OUT_OCTAVE_WIDTH = 2;
-// DATA[25:24]: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
+// DATA[25:24]: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
 localparam integer SC_POINT_OUT_SCALE_LSB = 24;
 localparam integer SC_POINT_OUT_SCALE_MSB = 25;
 localparam integer SC_POINT_OUT_SCALE_WIDTH = 2;

@@ -407,9 +407,9 @@ pub mod output_mode {
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
     #[repr(u32)]
     pub enum SobelOutput {
-        /// Every pixel of the selected scale of octave 1, in raster order (FIRST marks each line start).
+        /// Every pixel of the selected scale of octave 0 (full resolution), in raster order (FIRST marks each line start).
         Rows = 0,
-        /// Only the 16x16 patch around each point, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start).
+        /// Only the 16x16 patch around each point, taken from the selected scale of the point's own octave, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start).
         Patches = 1,
     }
 
@@ -642,7 +642,7 @@ pub mod latency_clocks {
     };
 }
 
-/// Head of the point FIFO; a read removes it. Layout of POINT_OUT's DATA plus VALID. Offset 0x3C, ro.
+/// Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID. Offset 0x3C, ro.
 pub mod point_fifo_data {
     #[allow(unused_imports)]
     use super::{Access, BitRange, Field, Register};
@@ -696,7 +696,7 @@ pub mod point_fifo_data {
         max: 3,
     };
 
-    /// `[25:24]` ro, reset 0: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
+    /// `[25:24]` ro, reset 0: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
     pub const SCALE: Field = Field {
         name: "POINT_FIFO_DATA.SCALE",
         offset: OFFSET,
@@ -730,7 +730,7 @@ pub mod point_fifo_data {
     };
 }
 
-/// Head of the Sobel FIFO; a read removes it. Layout of SOBEL_OUT's DATA plus VALID. Offset 0x40, ro.
+/// Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID. Offset 0x40, ro.
 pub mod sobel_fifo_data {
     #[allow(unused_imports)]
     use super::{Access, BitRange, Field, Register};
@@ -856,7 +856,7 @@ pub mod ports {
         pub const Y: BitRange = BitRange { lsb: 11, width: 11 };
         /// `DATA[23:22]`: Octave index, 0 = full resolution.
         pub const OCTAVE: BitRange = BitRange { lsb: 22, width: 2 };
-        /// `DATA[25:24]`: DoG level of the extremum inside its octave (1 or 2: the levels with a neighbour above and below).
+        /// `DATA[25:24]`: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
         pub const SCALE: BitRange = BitRange { lsb: 24, width: 2 };
         /// `DATA[26:26]`: 1: a maximum of the DoG, 0: a minimum.
         pub const POLARITY: BitRange = BitRange { lsb: 26, width: 1 };

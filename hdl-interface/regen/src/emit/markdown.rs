@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use super::hex32_grouped;
+use super::{hex32_grouped, readable};
 use crate::description::Description;
 use crate::BANNER;
 
@@ -86,10 +86,10 @@ pub fn emit(d: &Description) -> String {
             }
             let _ = writeln!(
                 o,
-                "| {bits} | {} | {} | {:#X} | {valid} | {doc} |",
+                "| {bits} | {} | {} | {} | {valid} | {doc} |",
                 f.name,
                 f.access.as_str(),
-                f.reset
+                readable(f.reset)
             );
         }
     }

@@ -23,3 +23,12 @@ pub fn camel_case(upper_snake: &str) -> String {
         })
         .collect()
 }
+
+/// Small values in decimal, large ones (codes, masks) in hex.
+pub fn readable(v: u32) -> String {
+    if v < 0x1000 {
+        v.to_string()
+    } else {
+        format!("{v:#X}")
+    }
+}

@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use super::{camel_case, hex32_grouped};
+use super::{camel_case, hex32_grouped, readable};
 use crate::description::{Access, Description, Field, Register};
 use crate::BANNER;
 
@@ -12,15 +12,6 @@ fn access_variant(a: Access) -> &'static str {
         Access::Rw => "Access::Rw",
         Access::W1c => "Access::W1c",
         Access::Wo => "Access::Wo",
-    }
-}
-
-/// Small values in decimal, large ones (codes, masks) in hex.
-fn readable(v: u32) -> String {
-    if v < 0x1000 {
-        v.to_string()
-    } else {
-        format!("{v:#X}")
     }
 }
 
