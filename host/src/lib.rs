@@ -3,8 +3,10 @@
 pub mod calib;
 pub mod descriptor;
 pub mod essential;
+pub mod estimator;
 pub mod frame;
 pub mod kalman;
 pub mod matching;
 pub mod ransac;
+pub mod subpixel;
 pub mod synth;
