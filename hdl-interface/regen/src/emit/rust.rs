@@ -33,14 +33,13 @@ pub fn emit(d: &Description) -> String {
     let _ = writeln!(o, "//!");
     let _ = writeln!(
         o,
-        "//! One module per register (byte offset, reset value, one [`Field`] per field, enums),"
+        "//! One module per register (byte offset, reset value, one [`Field`](crate::Field) per field, enums),"
     );
     let _ = writeln!(
         o,
         "//! [`REGISTERS`] for table-driven code, and [`ports`] for the stream-port layouts."
     );
-    o.push_str("#![allow(clippy::unusual_byte_groupings)]\n\n");
-    o.push_str("#[allow(unused_imports)]\nuse crate::{Access, BitRange, Field, Register};\n\n");
+    o.push_str("\nuse crate::Register;\n\n");
 
     let _ = writeln!(
         o,
@@ -86,8 +85,7 @@ pub fn emit(d: &Description) -> String {
     o.push_str("];\n\n");
 
     o.push_str("/// Stream ports: signal widths and the bit layout of each DATA word.\n");
-    o.push_str("pub mod ports {\n");
-    o.push_str("    #[allow(unused_imports)]\n    use crate::BitRange;\n");
+    o.push_str("pub mod ports {");
     for p in &d.ports {
         o.push('\n');
         doc_lines(
@@ -100,10 +98,9 @@ pub fn emit(d: &Description) -> String {
             ),
         );
         let _ = writeln!(o, "    pub mod {} {{", p.name.to_ascii_lowercase());
-        let _ = writeln!(
-            o,
-            "        #[allow(unused_imports)]\n        use super::BitRange;\n"
-        );
+        if !p.fields.is_empty() {
+            o.push_str("        use crate::BitRange;\n\n");
+        }
         for s in &p.signals {
             doc_lines(
                 &mut o,
@@ -144,9 +141,7 @@ fn emit_register(o: &mut String, r: &Register) {
         &format!("{} Offset {:#04X}, {}.", r.doc, r.offset, r.access.as_str()),
     );
     let _ = writeln!(o, "pub mod {} {{", r.name.to_ascii_lowercase());
-    o.push_str(
-        "    #[allow(unused_imports)]\n    use super::{Access, BitRange, Field, Register};\n\n",
-    );
+    o.push_str("    use crate::{Access, BitRange, Field, Register};\n\n");
     let _ = writeln!(o, "    /// Byte offset from [`super::BASE_ADDRESS`].");
     let _ = writeln!(o, "    pub const OFFSET: u16 = {:#04X};", r.offset);
     let _ = writeln!(o, "    /// Value after reset.");
