@@ -12,9 +12,15 @@ use core::slice::ChunksExact;
 pub trait Record: Copy {
     /// Bytes one record takes on the wire.
     const LEN: usize;
-    /// Reads a record from exactly [`Record::LEN`] bytes.
+    /// Reads a record from the first [`Record::LEN`] bytes of `bytes`.
+    ///
+    /// # Panics
+    /// If `bytes` is shorter than [`Record::LEN`]; [`Records`] never calls it so.
     fn read(bytes: &[u8]) -> Self;
-    /// Writes the record into exactly [`Record::LEN`] bytes.
+    /// Writes the record into the first [`Record::LEN`] bytes of `bytes`.
+    ///
+    /// # Panics
+    /// If `bytes` is shorter than [`Record::LEN`]; [`Records`] never calls it so.
     fn write(&self, bytes: &mut [u8]);
 }
 
@@ -52,10 +58,11 @@ impl<'a, R: Record> Records<'a, R> {
 
     /// Iterates over the records in wire order.
     pub fn iter(&self) -> RecordIter<'a, R> {
-        match *self {
-            Records::Wire(bytes) => RecordIter::Wire(bytes.chunks_exact(R::LEN)),
-            Records::Values(values) => RecordIter::Values(values.iter()),
-        }
+        let inner = match *self {
+            Records::Wire(bytes) => Source::Wire(bytes.chunks_exact(R::LEN)),
+            Records::Values(values) => Source::Values(values.iter()),
+        };
+        RecordIter { inner }
     }
 
     /// Bytes the records take on the wire.
@@ -100,28 +107,31 @@ impl<R: Record + defmt::Format> defmt::Format for Records<'_, R> {
     }
 }
 
-/// Iterator over [`Records`].
+/// Iterator over [`Records`], yielding records by value.
 #[derive(Clone, Debug)]
-pub enum RecordIter<'a, R: Record> {
-    /// Over wire bytes.
+pub struct RecordIter<'a, R: Record> {
+    inner: Source<'a, R>,
+}
+
+#[derive(Clone, Debug)]
+enum Source<'a, R: Record> {
     Wire(ChunksExact<'a, u8>),
-    /// Over values.
     Values(core::slice::Iter<'a, R>),
 }
 
 impl<R: Record> Iterator for RecordIter<'_, R> {
     type Item = R;
     fn next(&mut self) -> Option<R> {
-        match self {
-            RecordIter::Wire(chunks) => chunks.next().map(R::read),
-            RecordIter::Values(values) => values.next().copied(),
+        match &mut self.inner {
+            Source::Wire(chunks) => chunks.next().map(R::read),
+            Source::Values(values) => values.next().copied(),
         }
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
-        match self {
-            RecordIter::Wire(chunks) => chunks.size_hint(),
-            RecordIter::Values(values) => values.size_hint(),
+        match &self.inner {
+            Source::Wire(chunks) => chunks.size_hint(),
+            Source::Values(values) => values.size_hint(),
         }
     }
 }
