@@ -1,0 +1,158 @@
+//! Row kernels of the fast path, written over equal-length slices so the compiler vectorises
+//! them. Integer results are identical to the register-level stages.
+
+use crate::fabric::cordic::{CordicState, ATAN_BAM16};
+use crate::fabric::dog::dog;
+use crate::fabric::taps::{Taps, TAP_BITS};
+
+const ROUND: u32 = 1 << (TAP_BITS - 1);
+
+#[inline(always)]
+fn clamp(i: isize, last: usize) -> usize {
+    i.clamp(0, last as isize) as usize
+}
+
+#[inline(always)]
+fn dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u16 {
+    let s = t[0] as u32 * (a as u32 + e as u32)
+        + t[1] as u32 * (b as u32 + d as u32)
+        + t[2] as u32 * c as u32;
+    ((s + ROUND) >> TAP_BITS) as u16
+}
+
+/// Horizontal 5-tap filter of `src` into `dst` (same length), replicated border.
+pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
+    let w = src.len();
+    let dst = &mut dst[..w];
+    if w == 0 {
+        return;
+    }
+    let last = w - 1;
+    let border = |x: usize| {
+        let at = |k: isize| src[clamp(x as isize + k, last)];
+        dot(t, at(-2), at(-1), at(0), at(1), at(2))
+    };
+    if w >= 5 {
+        let n = w - 4;
+        let (s0, s1, s2, s3, s4) = (
+            &src[0..n],
+            &src[1..n + 1],
+            &src[2..n + 2],
+            &src[3..n + 3],
+            &src[4..n + 4],
+        );
+        let d = &mut dst[2..n + 2];
+        for i in 0..n {
+            d[i] = dot(t, s0[i], s1[i], s2[i], s3[i], s4[i]);
+        }
+        for x in [0, 1, w - 2, w - 1] {
+            dst[x] = border(x);
+        }
+    } else {
+        for (x, d) in dst.iter_mut().enumerate() {
+            *d = border(x);
+        }
+    }
+}
+
+/// Vertical 5-tap filter: `rows` are the input rows `y-2 ..= y+2` (already border-clamped).
+pub fn column_filter(t: &Taps, rows: [&[u16]; 5], dst: &mut [u16]) {
+    let n = dst.len();
+    let (r0, r1, r2, r3, r4) = (
+        &rows[0][..n],
+        &rows[1][..n],
+        &rows[2][..n],
+        &rows[3][..n],
+        &rows[4][..n],
+    );
+    for i in 0..n {
+        dst[i] = dot(t, r0[i], r1[i], r2[i], r3[i], r4[i]);
+    }
+}
+
+/// `dst[x] = dog(a[x], b[x])`.
+pub fn dog_row(a: &[u16], b: &[u16], dst: &mut [i16]) {
+    let n = dst.len();
+    let (a, b) = (&a[..n], &b[..n]);
+    for i in 0..n {
+        dst[i] = dog(a[i], b[i]);
+    }
+}
+
+/// Sobel of the centre row of `rows = [y-1, y, y+1]` (border-clamped), replicated columns.
+pub fn sobel_row(rows: [&[u16]; 3], sx: &mut [i32], sy: &mut [i32]) {
+    let w = sx.len();
+    let (a, b, c) = (&rows[0][..w], &rows[1][..w], &rows[2][..w]);
+    let at = |r: &[u16], i: isize| r[clamp(i, w - 1)] as i32;
+    let border = |x: usize| {
+        let x = x as isize;
+        let gx = (at(a, x + 1) + 2 * at(b, x + 1) + at(c, x + 1))
+            - (at(a, x - 1) + 2 * at(b, x - 1) + at(c, x - 1));
+        let gy = (at(c, x - 1) + 2 * at(c, x) + at(c, x + 1))
+            - (at(a, x - 1) + 2 * at(a, x) + at(a, x + 1));
+        (gx, gy)
+    };
+    if w >= 3 {
+        let n = w - 2;
+        let (a0, a1, a2) = (&a[0..n], &a[1..n + 1], &a[2..n + 2]);
+        let (b0, b2) = (&b[0..n], &b[2..n + 2]);
+        let (c0, c1, c2) = (&c[0..n], &c[1..n + 1], &c[2..n + 2]);
+        let (dx, dy) = (&mut sx[1..n + 1], &mut sy[1..n + 1]);
+        for i in 0..n {
+            let (a0, a1, a2) = (a0[i] as i32, a1[i] as i32, a2[i] as i32);
+            let (c0, c1, c2) = (c0[i] as i32, c1[i] as i32, c2[i] as i32);
+            dx[i] = (a2 + 2 * b2[i] as i32 + c2) - (a0 + 2 * b0[i] as i32 + c0);
+            dy[i] = (c0 + 2 * c1 + c2) - (a0 + 2 * a1 + a2);
+        }
+        for x in [0, w - 1] {
+            (sx[x], sy[x]) = border(x);
+        }
+    } else {
+        for x in 0..w {
+            (sx[x], sy[x]) = border(x);
+        }
+    }
+}
+
+/// Branch-free CORDIC over a row: the same fold, rotations and rounding as
+/// [`crate::fabric::cordic::cordic`], written with selects so it vectorises.
+pub fn cordic_row(sx: &[i32], sy: &[i32], magnitude: &mut [u8], orientation: &mut [u8]) {
+    let n = magnitude.len();
+    let (sx, sy, orientation) = (&sx[..n], &sy[..n], &mut orientation[..n]);
+    for i in 0..n {
+        let s = fold_select(sx[i], sy[i]);
+        let (mut x, mut y, mut z) = (s.x, s.y, s.z as i32);
+        for (k, &a) in ATAN_BAM16.iter().enumerate() {
+            let sign = 1 | (y >> 31); // +1 when y >= 0, -1 otherwise
+            let (dx, dy) = (y >> k, x >> k);
+            x += sign * dx;
+            y -= sign * dy;
+            z += sign * a as i32;
+        }
+        let mag = (x >> 1) + (x >> 3);
+        magnitude[i] = ((mag + 512) >> 10).clamp(0, 255) as u8;
+        orientation[i] = ((z + 512) >> 10) as u8 & 63;
+    }
+}
+
+/// Quadrant fold by two selects: half turn when below the x axis (or on its negative half),
+/// then a quarter turn when in the second quadrant. Equal to [`crate::fabric::cordic::fold`].
+#[inline(always)]
+pub(crate) fn fold_select(sx: i32, sy: i32) -> CordicState {
+    let half = sy < 0 || (sy == 0 && sx < 0);
+    let (x, y, z) = if half {
+        (-sx, -sy, 32768u16)
+    } else {
+        (sx, sy, 0)
+    };
+    let quarter = x <= 0 && y > 0;
+    if quarter {
+        CordicState {
+            x: y,
+            y: -x,
+            z: z + 16384,
+        }
+    } else {
+        CordicState { x, y, z }
+    }
+}

@@ -1,0 +1,164 @@
+//! The fast-path front end: octaves in cascade, a row per call.
+
+use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
+use crate::fabric::fast::octave::FastOctave;
+use crate::fabric::fast::probe::{NoProbe, Probe};
+use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
+
+/// Fast front end with the same width parameters as
+/// [`crate::fabric::pipeline::RegisterFrontEnd`].
+#[derive(Clone, Debug)]
+pub struct FastFrontEnd<
+    const W0: usize = 1280,
+    const W1: usize = 640,
+    const W2: usize = 320,
+    const W3: usize = 160,
+> {
+    o0: FastOctave<W0>,
+    o1: FastOctave<W1>,
+    o2: FastOctave<W2>,
+    o3: FastOctave<W3>,
+    input: [u16; W0],
+    fifos: OutputFifos<W0>,
+    config: Option<Config>,
+    rows_in: u16,
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> Default
+    for FastFrontEnd<W0, W1, W2, W3>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
+    FastFrontEnd<W0, W1, W2, W3>
+{
+    /// Row-memory lengths per octave.
+    pub const MAX_WIDTHS: [usize; MAX_OCTAVES] = [W0, W1, W2, W3];
+
+    /// An idle front end.
+    pub const fn new() -> Self {
+        const {
+            assert!(W1 >= W0.div_ceil(2) && W2 >= W1.div_ceil(2) && W3 >= W2.div_ceil(2));
+            assert!(W0 <= u16::MAX as usize);
+        }
+        Self {
+            o0: FastOctave::new(0),
+            o1: FastOctave::new(1),
+            o2: FastOctave::new(2),
+            o3: FastOctave::new(3),
+            input: [0; W0],
+            fifos: OutputFifos::new(),
+            config: None,
+            rows_in: 0,
+        }
+    }
+
+    /// [`FrontEnd::push_row`] with a probe that sees every scale and DoG row.
+    pub fn push_row_probed<P: Probe>(
+        &mut self,
+        row: &[u8],
+        probe: &mut P,
+    ) -> Result<(), FrameError> {
+        let cfg = self.config.ok_or(FrameError::NotStarted)?;
+        if row.len() != cfg.width as usize {
+            return Err(FrameError::RowLength {
+                expected: cfg.width,
+                got: row.len(),
+            });
+        }
+        if self.rows_in >= cfg.height {
+            return Err(FrameError::TooManyRows);
+        }
+        for (d, &p) in self.input.iter_mut().zip(row) {
+            *d = (p as u16) << 8;
+        }
+        self.rows_in += 1;
+        let w = row.len();
+        let Self {
+            o0, input, fifos, ..
+        } = self;
+        let sub = o0.tick(Some(&input[..w]), fifos, probe);
+        self.cascade(sub, probe);
+        Ok(())
+    }
+
+    /// [`FrontEnd::blank_row`] with a probe.
+    pub fn blank_row_probed<P: Probe>(&mut self, probe: &mut P) -> bool {
+        if self.config.is_some() {
+            let sub = self.o0.tick(None, &mut self.fifos, probe);
+            self.cascade(sub, probe);
+        }
+        self.frame_done()
+    }
+
+    /// Ticks octaves 1.. with the subsampled rows (or phantom ticks).
+    fn cascade<P: Probe>(&mut self, sub0: bool, probe: &mut P) {
+        let n = self.config.map_or(0, |c| c.octaves);
+        if n < 2 {
+            return;
+        }
+        let sub1 = self
+            .o1
+            .tick(sub0.then(|| self.o0.sub_row()), &mut self.fifos, probe);
+        if n < 3 {
+            return;
+        }
+        let sub2 = self
+            .o2
+            .tick(sub1.then(|| self.o1.sub_row()), &mut self.fifos, probe);
+        if n < 4 {
+            return;
+        }
+        self.o3
+            .tick(sub2.then(|| self.o2.sub_row()), &mut self.fifos, probe);
+    }
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEnd
+    for FastFrontEnd<W0, W1, W2, W3>
+{
+    fn start_frame(&mut self, config: &Config) -> Result<(), ConfigError> {
+        config.validate(Self::MAX_WIDTHS)?;
+        self.o0.start(config);
+        self.o1.start(config);
+        self.o2.start(config);
+        self.o3.start(config);
+        self.fifos.clear();
+        self.config = Some(*config);
+        self.rows_in = 0;
+        Ok(())
+    }
+
+    fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError> {
+        self.push_row_probed(row, &mut NoProbe)
+    }
+
+    fn blank_row(&mut self) -> bool {
+        self.blank_row_probed(&mut NoProbe)
+    }
+
+    fn frame_done(&self) -> bool {
+        let Some(cfg) = self.config else { return false };
+        let n = cfg.octaves;
+        self.rows_in == cfg.height
+            && self.o0.done()
+            && (n < 2 || self.o1.done())
+            && (n < 3 || self.o2.done())
+            && (n < 4 || self.o3.done())
+    }
+
+    fn pop_point(&mut self) -> Option<Extremum> {
+        self.fifos.pop_point()
+    }
+
+    fn pop_sobel(&mut self) -> Option<SobelPixel> {
+        self.fifos.pop_sobel()
+    }
+
+    fn overflow(&self) -> Overflow {
+        self.fifos.overflow()
+    }
+}

@@ -1,0 +1,15 @@
+//! The fast path: the same front end computed a row at a time on slices, for the host.
+//!
+//! Same integers as the register-level model (plain multiplies replace the LUT distributed
+//! arithmetic: `Σ_b LUT[bits_b] << b` is exactly `Σ_j tap_j · s_j`), same borders, same
+//! stream contents per octave; only the interleaving of octaves in the FIFOs differs.
+//! `tests/bit_exact.rs` proves the equality on random and real images.
+
+mod filter;
+mod frontend;
+mod octave;
+mod probe;
+
+pub use filter::{column_filter, cordic_row, dog_row, row_filter, sobel_row};
+pub use frontend::FastFrontEnd;
+pub use probe::{NoProbe, Probe};

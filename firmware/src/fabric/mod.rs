@@ -1,0 +1,48 @@
+//! The FPGA front end ("fabric"), modelled stage by stage.
+//!
+//! Two implementations produce bit-identical outputs behind one trait, [`FrontEnd`]:
+//! - [`RegisterFrontEnd`]: the register-level model, one [`RegisterFrontEnd::clock`] per pixel
+//!   with explicit pipeline registers, line memories and the hardware's bit widths. It is the
+//!   specification the RTL must match clock for clock.
+//! - [`FastFrontEnd`]: a row-at-a-time implementation of the same arithmetic for the host.
+//!
+//! # Data path and widths
+//! | signal | format |
+//! |---|---|
+//! | camera pixel | `u8` |
+//! | scale images G0..G3 | `u16` Q8.8 (octave 0 input is `pixel << 8`) |
+//! | taps | 10-bit, sum 1024 ([`taps`]) |
+//! | DoG | `i16` Q8.8, saturating |
+//! | Sobel `Sx, Sy` | 19-bit signed |
+//! | offsets `dx, dy, ds` | `I3F13` (Q2.13) |
+//! | magnitude / orientation | `u8` / 6-bit |
+//!
+//! Stages: [`linebuffer`], [`convolver`] (row then column, LUT distributed arithmetic), [`dog`],
+//! [`window`], [`extrema`], [`edge`], [`refine`], [`sobel`], [`cordic`], [`subsample`],
+//! assembled in [`octave`] and [`pipeline`]; [`latency`] and [`memory`] give the figures.
+
+pub mod config;
+pub mod convolver;
+pub mod cordic;
+pub mod dog;
+pub mod edge;
+pub mod extrema;
+pub mod fast;
+pub mod fifo;
+pub mod geometry;
+pub mod latency;
+pub mod linebuffer;
+pub mod memory;
+pub mod octave;
+pub mod output;
+pub mod pipeline;
+pub mod refine;
+pub mod sobel;
+pub mod subsample;
+pub mod taps;
+pub mod window;
+
+pub use config::{Config, ConfigError};
+pub use fast::FastFrontEnd;
+pub use output::{run_frame, Extremum, FrameError, FrontEnd, Overflow, SobelPixel};
+pub use pipeline::RegisterFrontEnd;

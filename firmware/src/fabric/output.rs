@@ -1,0 +1,248 @@
+//! What the front end hands the soft-core: a point stream and a Sobel stream in bounded FIFOs
+//! with overflow counters, and the [`FrontEnd`] trait both implementations share.
+//!
+//! # Driver contract
+//! 1. `start_frame(&config)` (register writes + frame start).
+//! 2. For each input row: `push_row(&row)`, then drain both FIFOs (`pop_point`, `pop_sobel`
+//!    until `None`). One input row produces at most `2·W0` Sobel pixels and the Sobel FIFO
+//!    holds `3·W0`, so draining after every row never overflows.
+//! 3. Vertical blanking: `blank_row()` (one row time of clocks without pixels) and drain, until
+//!    it returns `true` (every octave has emitted everything).
+//! 4. `overflow()` tells how many items were dropped because the driver fell behind; the
+//!    counters are never reset silently (`start_frame` clears them, so read them first).
+//!
+//! Within one octave both streams come in raster order; the octaves are interleaved in an
+//! implementation-defined way (the register-level model interleaves them by clock, the fast
+//! path by row), so consumers key on the `octave` field.
+
+use crate::fabric::config::{Config, ConfigError};
+use crate::fabric::fifo::LineFifo;
+use crate::fabric::refine::Offset;
+
+/// A refined DoG extremum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Extremum {
+    /// Column in the octave's own pixel grid.
+    pub x: u16,
+    /// Row in the octave's own pixel grid.
+    pub y: u16,
+    /// Octave 0..4 (octave `k` pixels are `2^k` input pixels apart).
+    pub octave: u8,
+    /// DoG index of the centre sample (always 1: the middle of the three DoG images).
+    pub scale: u8,
+    /// Sub-pixel column offset, Q2.13.
+    pub dx: Offset,
+    /// Sub-pixel row offset, Q2.13.
+    pub dy: Offset,
+    /// Sub-scale offset in DoG-index units, Q2.13.
+    pub ds: Offset,
+    /// DoG sample at the centre, Q8.8 grey levels (sign tells maximum from minimum).
+    pub dog: i16,
+}
+
+impl Extremum {
+    /// Power-up content of FIFO memories.
+    pub const ZERO: Self = Self {
+        x: 0,
+        y: 0,
+        octave: 0,
+        scale: 0,
+        dx: Offset::ZERO,
+        dy: Offset::ZERO,
+        ds: Offset::ZERO,
+        dog: 0,
+    };
+}
+
+/// One Sobel output pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SobelPixel {
+    /// Octave 0..4.
+    pub octave: u8,
+    /// Orientation bin 0..64 (5.625° each, from +x toward +y).
+    pub orientation: u8,
+    /// Magnitude code (see [`crate::fabric::cordic`]).
+    pub magnitude: u8,
+    /// Column in the octave grid.
+    pub x: u16,
+    /// Row in the octave grid.
+    pub y: u16,
+}
+
+/// Items dropped because a FIFO was full.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Overflow {
+    pub points: u32,
+    pub sobel: u32,
+}
+
+/// Capacity of the point FIFO.
+pub const POINT_FIFO_CAPACITY: usize = 512;
+
+/// The two output FIFOs of a front end whose octave 0 is at most `W0` wide.
+#[derive(Clone, Debug)]
+pub struct OutputFifos<const W0: usize> {
+    points: LineFifo<Extremum, 64, 8>,
+    sobel: LineFifo<SobelPixel, W0, 3>,
+    overflow: Overflow,
+}
+
+impl<const W0: usize> Default for OutputFifos<W0> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const W0: usize> OutputFifos<W0> {
+    /// Empty FIFOs.
+    pub const fn new() -> Self {
+        Self {
+            points: LineFifo::new(Extremum::ZERO),
+            sobel: LineFifo::new(SobelPixel {
+                octave: 0,
+                orientation: 0,
+                magnitude: 0,
+                x: 0,
+                y: 0,
+            }),
+            overflow: Overflow {
+                points: 0,
+                sobel: 0,
+            },
+        }
+    }
+
+    /// Empties both FIFOs and clears the counters.
+    pub fn clear(&mut self) {
+        self.points.clear();
+        self.sobel.clear();
+        self.overflow = Overflow::default();
+    }
+
+    /// Enqueues a point, counting it when full.
+    #[inline]
+    pub fn push_point(&mut self, p: Extremum) {
+        if self.points.push(p).is_err() {
+            self.overflow.points = self.overflow.points.saturating_add(1);
+        }
+    }
+
+    /// Enqueues a Sobel pixel, counting it when full.
+    #[inline]
+    pub fn push_sobel(&mut self, s: SobelPixel) {
+        if self.sobel.push(s).is_err() {
+            self.overflow.sobel = self.overflow.sobel.saturating_add(1);
+        }
+    }
+
+    /// Oldest point.
+    #[inline]
+    pub fn pop_point(&mut self) -> Option<Extremum> {
+        self.points.pop()
+    }
+
+    /// Oldest Sobel pixel.
+    #[inline]
+    pub fn pop_sobel(&mut self) -> Option<SobelPixel> {
+        self.sobel.pop()
+    }
+
+    /// Drop counters.
+    pub fn overflow(&self) -> Overflow {
+        self.overflow
+    }
+}
+
+/// A frame was fed wrongly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameError {
+    /// `push_row` before a successful `start_frame`.
+    NotStarted,
+    /// A row of the wrong length.
+    RowLength { expected: u16, got: usize },
+    /// More rows than `Config::height`.
+    TooManyRows,
+    /// An image buffer whose length is not `width·height`.
+    ImageSize { expected: usize, got: usize },
+    /// The configuration was refused.
+    Config(ConfigError),
+    /// The pipeline did not drain within the bound of blanking rows (a model defect).
+    FlushTimeout,
+}
+
+impl core::fmt::Display for FrameError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::NotStarted => write!(f, "row pushed before start_frame"),
+            Self::RowLength { expected, got } => {
+                write!(f, "row of {got} pixels, configured width is {expected}")
+            }
+            Self::TooManyRows => write!(f, "more rows than the configured height"),
+            Self::ImageSize { expected, got } => {
+                write!(f, "image of {got} pixels, expected {expected}")
+            }
+            Self::Config(e) => write!(f, "configuration refused: {e}"),
+            Self::FlushTimeout => write!(f, "front end did not drain during blanking"),
+        }
+    }
+}
+
+/// The interface the soft-core driver uses, implemented by the register-level model
+/// ([`crate::fabric::pipeline::RegisterFrontEnd`]) and the fast path
+/// ([`crate::fabric::fast::FastFrontEnd`]). Both produce bit-identical streams.
+pub trait FrontEnd {
+    /// Configures and starts a frame; clears the FIFOs and counters.
+    fn start_frame(&mut self, config: &Config) -> Result<(), ConfigError>;
+    /// Feeds one row of 8-bit grey pixels.
+    fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError>;
+    /// One row time of vertical blanking; `true` once the frame is completely processed.
+    fn blank_row(&mut self) -> bool;
+    /// Whether the frame is completely processed.
+    fn frame_done(&self) -> bool;
+    /// Oldest point of the point FIFO.
+    fn pop_point(&mut self) -> Option<Extremum>;
+    /// Oldest pixel of the Sobel FIFO.
+    fn pop_sobel(&mut self) -> Option<SobelPixel>;
+    /// Items dropped so far this frame.
+    fn overflow(&self) -> Overflow;
+}
+
+/// Runs a whole `config.width x config.height` frame through `fe`, draining the FIFOs after
+/// every row into the two callbacks. Returns the overflow counters.
+pub fn run_frame<F: FrontEnd + ?Sized>(
+    fe: &mut F,
+    config: &Config,
+    image: &[u8],
+    on_point: &mut dyn FnMut(Extremum),
+    on_sobel: &mut dyn FnMut(SobelPixel),
+) -> Result<Overflow, FrameError> {
+    let (w, h) = (config.width as usize, config.height as usize);
+    if image.len() != w * h {
+        return Err(FrameError::ImageSize {
+            expected: w * h,
+            got: image.len(),
+        });
+    }
+    fe.start_frame(config).map_err(FrameError::Config)?;
+    let mut drain = |fe: &mut F| {
+        while let Some(p) = fe.pop_point() {
+            on_point(p);
+        }
+        while let Some(s) = fe.pop_sobel() {
+            on_sobel(s);
+        }
+    };
+    for row in image.chunks_exact(w) {
+        fe.push_row(row)?;
+        drain(fe);
+    }
+    // Octave k drains in about 10·2^k input rows; 4·h + 64 is a generous bound.
+    for _ in 0..4 * h + 64 {
+        let done = fe.blank_row();
+        drain(fe);
+        if done {
+            return Ok(fe.overflow());
+        }
+    }
+    Err(FrameError::FlushTimeout)
+}

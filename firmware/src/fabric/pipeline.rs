@@ -1,0 +1,178 @@
+//! The register-level front end: up to four [`Octave`]s in cascade, one input pixel per clock,
+//! and the output FIFOs. This is the clock-for-clock specification of the RTL.
+//!
+//! Octave `k` has line memories for `Wk` pixels; the defaults (1280, 640, 320, 160) take any
+//! input up to 1280 wide. Each `Wk` must be at least `ceil(W(k-1) / 2)` and at least 12 (the
+//! alignment FIFOs are sized in whole lines), checked at compile time.
+
+use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
+use crate::fabric::octave::Octave;
+use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
+
+/// Register-level front end (see the module docs for the width parameters).
+#[derive(Clone, Debug)]
+pub struct RegisterFrontEnd<
+    const W0: usize = 1280,
+    const W1: usize = 640,
+    const W2: usize = 320,
+    const W3: usize = 160,
+> {
+    o0: Octave<W0>,
+    o1: Octave<W1>,
+    o2: Octave<W2>,
+    o3: Octave<W3>,
+    fifos: OutputFifos<W0>,
+    config: Option<Config>,
+    rows_in: u16,
+    clock: u64,
+    first_input: [Option<u64>; MAX_OCTAVES],
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> Default
+    for RegisterFrontEnd<W0, W1, W2, W3>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
+    RegisterFrontEnd<W0, W1, W2, W3>
+{
+    /// An idle front end.
+    pub const fn new() -> Self {
+        const {
+            assert!(W1 >= W0.div_ceil(2) && W2 >= W1.div_ceil(2) && W3 >= W2.div_ceil(2));
+            assert!(W0 >= 12 && W1 >= 12 && W2 >= 12 && W3 >= 12);
+            assert!(W0 <= u16::MAX as usize);
+        }
+        Self {
+            o0: Octave::new(0),
+            o1: Octave::new(1),
+            o2: Octave::new(2),
+            o3: Octave::new(3),
+            fifos: OutputFifos::new(),
+            config: None,
+            rows_in: 0,
+            clock: 0,
+            first_input: [None; MAX_OCTAVES],
+        }
+    }
+
+    /// Line-memory lengths per octave.
+    pub const MAX_WIDTHS: [usize; MAX_OCTAVES] = [W0, W1, W2, W3];
+
+    /// Clocks since `start_frame`.
+    pub fn clocks(&self) -> u64 {
+        self.clock
+    }
+
+    /// Clock (counted from the first pixel of the frame at clock 0) at which octave `k` took
+    /// its first input sample.
+    pub fn first_input_clock(&self, k: usize) -> Option<u64> {
+        self.first_input.get(k).copied().flatten()
+    }
+
+    /// Alignment FIFO faults summed over the octaves (zero unless the model is wrong).
+    pub fn align_errors(&self) -> u32 {
+        self.o0.align_errors()
+            + self.o1.align_errors()
+            + self.o2.align_errors()
+            + self.o3.align_errors()
+    }
+
+    /// One pixel clock; `pixel = None` is a clock without a valid pixel (blanking).
+    pub fn clock(&mut self, pixel: Option<u8>) {
+        let Some(cfg) = self.config else { return };
+        let n = cfg.octaves as usize;
+        let now = self.clock;
+        let mut note = |k: usize, v: Option<u16>| {
+            if v.is_some() && self.first_input[k].is_none() {
+                self.first_input[k] = Some(now);
+            }
+        };
+        let x0 = pixel.map(|p| (p as u16) << 8);
+        note(0, x0);
+        let x1 = self.o0.clock(x0, &mut self.fifos);
+        if n > 1 {
+            note(1, x1);
+            let x2 = self.o1.clock(x1, &mut self.fifos);
+            if n > 2 {
+                note(2, x2);
+                let x3 = self.o2.clock(x2, &mut self.fifos);
+                if n > 3 {
+                    note(3, x3);
+                    self.o3.clock(x3, &mut self.fifos);
+                }
+            }
+        }
+        self.clock += 1;
+    }
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEnd
+    for RegisterFrontEnd<W0, W1, W2, W3>
+{
+    fn start_frame(&mut self, config: &Config) -> Result<(), ConfigError> {
+        config.validate(Self::MAX_WIDTHS)?;
+        self.o0.start(config);
+        self.o1.start(config);
+        self.o2.start(config);
+        self.o3.start(config);
+        self.fifos.clear();
+        self.config = Some(*config);
+        self.rows_in = 0;
+        self.clock = 0;
+        self.first_input = [None; MAX_OCTAVES];
+        Ok(())
+    }
+
+    fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError> {
+        let cfg = self.config.ok_or(FrameError::NotStarted)?;
+        if row.len() != cfg.width as usize {
+            return Err(FrameError::RowLength {
+                expected: cfg.width,
+                got: row.len(),
+            });
+        }
+        if self.rows_in >= cfg.height {
+            return Err(FrameError::TooManyRows);
+        }
+        for &p in row {
+            self.clock(Some(p));
+        }
+        self.rows_in += 1;
+        Ok(())
+    }
+
+    fn blank_row(&mut self) -> bool {
+        if let Some(cfg) = self.config {
+            for _ in 0..cfg.width {
+                self.clock(None);
+            }
+        }
+        self.frame_done()
+    }
+
+    fn frame_done(&self) -> bool {
+        let Some(cfg) = self.config else { return false };
+        let n = cfg.octaves;
+        self.rows_in == cfg.height
+            && self.o0.done()
+            && (n < 2 || self.o1.done())
+            && (n < 3 || self.o2.done())
+            && (n < 4 || self.o3.done())
+    }
+
+    fn pop_point(&mut self) -> Option<Extremum> {
+        self.fifos.pop_point()
+    }
+
+    fn pop_sobel(&mut self) -> Option<SobelPixel> {
+        self.fifos.pop_sobel()
+    }
+
+    fn overflow(&self) -> Overflow {
+        self.fifos.overflow()
+    }
+}
