@@ -97,11 +97,17 @@ pub fn step(s: CordicState, i: u32) -> CordicState {
     }
 }
 
-/// Step 4: raw magnitude `x·5/8` (Q8.8 Sobel units) and the 6-bit orientation.
+/// Step 4: raw magnitude `x·5/8` (Q8.8 Sobel units) and the 6-bit orientation (0 for the
+/// zero vector).
 #[inline]
 pub fn finish(s: CordicState) -> (i32, u8) {
     let mag = (s.x >> 1) + (s.x >> 3);
-    let ori = (s.z.wrapping_add(512) >> 10) as u8 & 63;
+    // A zero vector (the only one with x_n = 0) has orientation 0 by convention.
+    let ori = if s.x == 0 {
+        0
+    } else {
+        (s.z.wrapping_add(512) >> 10) as u8 & 63
+    };
     (mag, ori)
 }
 

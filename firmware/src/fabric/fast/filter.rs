@@ -131,7 +131,11 @@ pub fn cordic_row(sx: &[i32], sy: &[i32], magnitude: &mut [u8], orientation: &mu
         }
         let mag = (x >> 1) + (x >> 3);
         magnitude[i] = ((mag + 512) >> 10).clamp(0, 255) as u8;
-        orientation[i] = ((z + 512) >> 10) as u8 & 63;
+        orientation[i] = if x == 0 {
+            0
+        } else {
+            ((z + 512) >> 10) as u8 & 63
+        };
     }
 }
 

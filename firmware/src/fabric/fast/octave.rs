@@ -248,8 +248,19 @@ impl<const W: usize> FastOctave<W> {
         let rows = [(r as usize - 2) % 3, (r as usize - 1) % 3, r as usize % 3];
         let thr = self.config.contrast_threshold as i32;
         for x in 1..w - 1 {
-            let v = self.dog[1][rows[1]][x] as i32;
-            if v <= thr && v >= -thr {
+            // Necessary conditions first (contrast, then the two row neighbours), so the
+            // 26-neighbour test only runs on the few survivors; the verdict is unchanged.
+            let row = &self.dog[1][rows[1]];
+            let v = row[x] as i32;
+            let (l, r) = (row[x - 1] as i32, row[x + 1] as i32);
+            let maybe = if v > thr {
+                l < v && r < v
+            } else if v < -thr {
+                l > v && r > v
+            } else {
+                false
+            };
+            if !maybe {
                 continue;
             }
             let mut c: Cube = [[[0; 3]; 3]; 3];
