@@ -114,29 +114,15 @@ pub fn describe(frame: &FeatureFrame, config: &DescriptorConfig) -> DescriptorSe
     };
     let mut window = [(0u8, 0u8); PATCH_SIZE * PATCH_SIZE];
     let mut hist = [0f32; 128];
-    let half = (PATCH_SIZE / 2) as i32;
     for k in 0..n {
-        let mut present = 0;
-        for (i, w) in window.iter_mut().enumerate() {
-            let dx = (i % PATCH_SIZE) as i32 - half;
-            let dy = (i / PATCH_SIZE) as i32 - half;
-            *w = match frame.window_sample(k, dx, dy) {
-                Some(s) => {
-                    present += 1;
-                    s
-                }
-                None => (0, 0),
-            };
-        }
-        if present < MIN_COVERAGE {
+        if frame.window(k, &mut window) < MIN_COVERAGE {
             continue;
         }
-        let angle = if config.rotate {
-            dominant_orientation(&window)
+        if config.rotate {
+            accumulate(&window, config.mode, dominant_orientation(&window), &mut hist[..dim]);
         } else {
-            0.0
-        };
-        accumulate(&window, config.mode, angle, &mut hist[..dim]);
+            accumulate_fixed(&window, config.mode, &mut hist[..dim]);
+        }
         let start = set.data.len();
         set.data.resize(start + dim, 0);
         quantize(&mut hist[..dim], &mut set.data[start..]);
@@ -226,6 +212,73 @@ fn accumulate(window: &[(u8, u8)], mode: DescriptorMode, angle: f32, hist: &mut 
                     hist[base + bin] += w * wy * wx * wo;
                 }
             }
+        }
+    }
+}
+
+/// Up to four (cell, weight) spatial contributions of one window sample, Gaussian included.
+#[derive(Clone, Copy, Default)]
+struct Spread {
+    cells: [(u8, f32); 4],
+}
+
+/// Spatial spreads of every window sample for the unrotated window (the same for every
+/// keypoint, computed once per mode).
+fn spreads(mode: DescriptorMode) -> &'static [Spread; PATCH_SIZE * PATCH_SIZE] {
+    use std::sync::OnceLock;
+    static FULL: OnceLock<[Spread; PATCH_SIZE * PATCH_SIZE]> = OnceLock::new();
+    static REDUCED: OnceLock<[Spread; PATCH_SIZE * PATCH_SIZE]> = OnceLock::new();
+    let cell = match mode {
+        DescriptorMode::Full128 => &FULL,
+        DescriptorMode::Reduced16 => &REDUCED,
+    };
+    cell.get_or_init(|| {
+        let cells = mode.cells();
+        let cell_px = (PATCH_SIZE / cells) as f32;
+        let half = (PATCH_SIZE / 2) as f32;
+        std::array::from_fn(|i| {
+            let (x, y) = offset(i);
+            let g = (-(x * x + y * y) / (2.0 * WINDOW_SIGMA * WINDOW_SIGMA)).exp();
+            let cx = (x + half) / cell_px - 0.5;
+            let cy = (y + half) / cell_px - 0.5;
+            let (ix, iy) = (cx.floor(), cy.floor());
+            let (fx, fy) = (cx - ix, cy - iy);
+            let mut s = Spread::default();
+            let mut n = 0;
+            for (dy, wy) in [(0, 1.0 - fy), (1, fy)] {
+                for (dx, wx) in [(0, 1.0 - fx), (1, fx)] {
+                    let (xx, yy) = (ix as i32 + dx, iy as i32 + dy);
+                    if (0..cells as i32).contains(&xx) && (0..cells as i32).contains(&yy) {
+                        s.cells[n] = ((yy as usize * cells + xx as usize) as u8, g * wx * wy);
+                        n += 1;
+                    }
+                }
+            }
+            s
+        })
+    })
+}
+
+/// [`accumulate`] for the unrotated window, with the spatial weights from a table.
+fn accumulate_fixed(window: &[(u8, u8)], mode: DescriptorMode, hist: &mut [f32]) {
+    hist.fill(0.0);
+    let bins = mode.bins();
+    let shift = (ORIENTATION_STEPS as usize / bins).trailing_zeros();
+    let frac_scale = 1.0 / (ORIENTATION_STEPS as usize / bins) as f32;
+    for (&(m, o), spread) in window.iter().zip(spreads(mode).iter()) {
+        if m == 0 {
+            continue;
+        }
+        // Orientation bin and its interpolation weight from the 6-bit code.
+        let b0 = (o as usize >> shift) % bins;
+        let b1 = (b0 + 1) % bins;
+        let fo = (o as usize & ((1 << shift) - 1)) as f32 * frac_scale;
+        let mf = m as f32;
+        for &(cell, w) in &spread.cells {
+            let base = cell as usize * bins;
+            let w = mf * w;
+            hist[base + b0] += w * (1.0 - fo);
+            hist[base + b1] += w * fo;
         }
     }
 }
@@ -323,6 +376,22 @@ mod tests {
         let d_fixed = dist(describe(&a, &fixed).get(0), describe(&b, &fixed).get(0));
         let d_rot = dist(describe(&a, &rot).get(0), describe(&b, &rot).get(0));
         assert!(d_rot * 4 < d_fixed, "rotated {d_rot} vs fixed {d_fixed}");
+    }
+
+    #[test]
+    fn table_path_equals_the_general_path_at_zero_rotation() {
+        let a = frame(plane(64, 64, 0, false), &[(30.0, 30.0)]);
+        let mut window = [(0u8, 0u8); 256];
+        a.window(0, &mut window);
+        for mode in [DescriptorMode::Full128, DescriptorMode::Reduced16] {
+            let mut h1 = [0f32; 128];
+            let mut h2 = [0f32; 128];
+            accumulate(&window, mode, 0.0, &mut h1[..mode.len()]);
+            accumulate_fixed(&window, mode, &mut h2[..mode.len()]);
+            for (x, y) in h1.iter().zip(&h2) {
+                assert!((x - y).abs() <= 1e-3 * x.abs().max(1.0), "{x} vs {y}");
+            }
+        }
     }
 
     #[test]

@@ -83,6 +83,19 @@ pub fn sampson_residual(e: &Matrix3<f64>, c: &Correspondence) -> f64 {
     }
 }
 
+/// Cauchy cost `Σ ln(1 + (r/c)²)` of the Sampson residuals of `e`, with `c = 2.385·sigma`:
+/// compares candidate solutions on the same robust scale.
+pub fn cauchy_cost(e: &Matrix3<f64>, matches: &[Correspondence], sigma: f64) -> f64 {
+    let c = 2.385 * sigma;
+    matches
+        .iter()
+        .map(|m| {
+            let r = sampson_residual(e, m) / c;
+            (1.0 + r * r).ln()
+        })
+        .sum()
+}
+
 /// The M-estimator used by the iterative refinements (IRLS weights).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum RobustLoss {

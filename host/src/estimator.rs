@@ -11,7 +11,7 @@ use crate::calib::Calibration;
 use crate::descriptor::{describe, DescriptorConfig};
 use crate::essential::constrained::{self, VergeAngles};
 use crate::essential::general::{self, RelativePose, YawPitchRoll};
-use crate::essential::{Correspondence, EssentialError, RefineConfig};
+use crate::essential::{cauchy_cost, Correspondence, EssentialError, RefineConfig};
 use crate::frame::FeatureFrame;
 use crate::matching::{match_descriptors, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
@@ -194,11 +194,27 @@ impl VergeEstimator {
             residual_px: cfit.residual_sigma * focal,
         };
         if self.config.model == Model::General {
-            let gfit = general::refine(
-                &corr,
+            // Two starts: the constrained solution (right when the head only verges) and the
+            // nominal parallel head (right when a tilt misleads the constrained fit); the
+            // lower robust cost on a common scale wins.
+            let starts = [
                 RelativePose::from_verge(cfit.angles),
-                &self.config.refine,
-            )?;
+                RelativePose::from_verge(VergeAngles::new(0.0, 0.0)),
+            ];
+            let fits: Vec<_> = starts
+                .iter()
+                .filter_map(|s| general::refine(&corr, *s, &self.config.refine).ok())
+                .collect();
+            let scale = fits
+                .iter()
+                .map(|f| f.residual_sigma)
+                .fold(f64::INFINITY, f64::min);
+            let gfit = fits
+                .into_iter()
+                .map(|f| (cauchy_cost(&f.pose.essential(), &corr, scale), f))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, f)| f)
+                .ok_or(EssentialError::Degenerate)?;
             est.verge_deg = gfit.pose.verge().to_degrees();
             est.sigma_deg = gfit.verge_sigma.to_degrees();
             est.angles = None;

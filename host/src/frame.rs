@@ -230,6 +230,60 @@ impl FeatureFrame {
         }
     }
 
+    /// Copies the 16×16 gradient window of keypoint `k` into `out` (row-major, the
+    /// [`SobelPatch`] layout; unavailable samples are `(0, 0)`) and returns how many samples
+    /// were available.
+    pub fn window(&self, k: usize, out: &mut [(u8, u8); PATCH_SIZE * PATCH_SIZE]) -> usize {
+        out.fill((0, 0));
+        let Some(kp) = self.keypoints.get(k) else {
+            return 0;
+        };
+        match &self.gradients {
+            Gradients::Patches(p) => match p.get(k) {
+                Some(patch) => {
+                    for (o, (&m, &a)) in out
+                        .iter_mut()
+                        .zip(patch.magnitude.iter().zip(patch.orientation.iter()))
+                    {
+                        *o = (m, a);
+                    }
+                    PATCH_SIZE * PATCH_SIZE
+                }
+                None => 0,
+            },
+            Gradients::Planes(_) => {
+                let Some(plane) = self.plane(kp.octave) else {
+                    return 0;
+                };
+                let (ox, oy) = kp.octave_position();
+                let half = (PATCH_SIZE / 2) as i64;
+                let (x0, y0) = (ox.round() as i64 - half, oy.round() as i64 - half);
+                let (w, h) = (plane.width as i64, plane.height as i64);
+                let xa = x0.max(0);
+                let xb = (x0 + PATCH_SIZE as i64).min(w);
+                if xa >= xb {
+                    return 0;
+                }
+                let mut count = 0;
+                for r in 0..PATCH_SIZE as i64 {
+                    let y = y0 + r;
+                    if y < 0 || y >= h {
+                        continue;
+                    }
+                    let row = (y * w) as usize;
+                    let mags = &plane.magnitude[row + xa as usize..row + xb as usize];
+                    let oris = &plane.orientation[row + xa as usize..row + xb as usize];
+                    let dst = &mut out[(r as usize * PATCH_SIZE + (xa - x0) as usize)..];
+                    for (d, (&m, &a)) in dst.iter_mut().zip(mags.iter().zip(oris)) {
+                        *d = (m, a);
+                    }
+                    count += (xb - xa) as usize;
+                }
+                count
+            }
+        }
+    }
+
     /// `(magnitude, orientation)` of the gradient window of keypoint `k` at window offset
     /// `(dx, dy)` ∈ [-8, 8)² from its rounded octave position; `None` when unavailable.
     pub fn window_sample(&self, k: usize, dx: i32, dy: i32) -> Option<(u8, u8)> {
@@ -309,6 +363,15 @@ mod tests {
             .unwrap();
         assert_eq!(f.window_sample(0, 0, 0), Some((6, 0)));
         assert_eq!(f.window_sample(0, 1, 1), Some((11, 0)));
+        let mut win = [(0u8, 0u8); 256];
+        // Window rows -8..8 around octave pixel (2, 1): only the 4x4 plane is inside.
+        assert_eq!(f.window(0, &mut win), 16);
+        for dy in -8..8 {
+            for dx in -8..8 {
+                let i = ((dy + 8) * 16 + dx + 8) as usize;
+                assert_eq!(Some(win[i]).filter(|_| f.window_sample(0, dx, dy).is_some()), f.window_sample(0, dx, dy));
+            }
+        }
         assert!(f.plane(0).is_none());
     }
 }

@@ -6,8 +6,8 @@
 //! ratio test; optionally the match must also be the left keypoint's best from the right
 //! side (left-right consistency); optionally only the N best are kept.
 //!
-//! Distances are squared Euclidean over `u8` elements accumulated in `u32`: a plain loop over
-//! fixed-size chunks that the compiler turns into SIMD.
+//! Distances are squared Euclidean over `u8` elements accumulated in `u32` lanes: a plain loop
+//! the compiler turns into SIMD.
 
 use crate::descriptor::DescriptorSet;
 use crate::frame::Keypoint;
@@ -54,23 +54,25 @@ pub struct Match {
 /// Squared Euclidean distance of two descriptors of equal length.
 #[inline]
 pub fn distance_sq(a: &[u8], b: &[u8]) -> u32 {
-    // 16-wide chunks: the compiler widens to i16/i32 lanes and vectorises each chunk.
-    let mut acc = 0u32;
-    let mut ca = a.chunks_exact(16);
-    let mut cb = b.chunks_exact(16);
-    for (x, y) in (&mut ca).zip(&mut cb) {
-        let mut s = 0u32;
+    // Sixteen independent lane accumulators over 16-byte blocks: LLVM keeps them in vector
+    // registers (widening subtract, multiply-add), without a horizontal sum per block.
+    let mut lanes = [0u32; 16];
+    let (ca, cb) = (a.chunks_exact(16), b.chunks_exact(16));
+    let tail: u32 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(&x, &y)| (x as i32 - y as i32).pow(2) as u32)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        let x: [u8; 16] = x.try_into().unwrap_or([0; 16]);
+        let y: [u8; 16] = y.try_into().unwrap_or([0; 16]);
         for i in 0..16 {
             let d = x[i] as i32 - y[i] as i32;
-            s += (d * d) as u32;
+            lanes[i] += (d * d) as u32;
         }
-        acc += s;
     }
-    for (&x, &y) in ca.remainder().iter().zip(cb.remainder()) {
-        let d = x as i32 - y as i32;
-        acc += (d * d) as u32;
-    }
-    acc
+    lanes.iter().sum::<u32>() + tail
 }
 
 /// Matches the left descriptors against the right ones. Keypoint slices are the frames'
@@ -90,6 +92,9 @@ pub fn match_descriptors(
     let ry = |j: u32| right_kp[right.keypoint(j as usize)].y;
     order.sort_by(|&a, &b| ry(a).total_cmp(&ry(b)));
     let ys: Vec<f32> = order.iter().map(|&j| ry(j)).collect();
+    // The right descriptors copied in y order, so that each band is one contiguous run.
+    let dim = right.dim();
+    let sorted: Vec<u8> = order.iter().flat_map(|&j| right.get(j as usize).iter().copied()).collect();
     let band = config.max_vertical_px.unwrap_or(f32::INFINITY);
 
     // Best left (distance, index) per right descriptor, for the cross check.
@@ -101,8 +106,9 @@ pub fn match_descriptors(
         let hi = ys.partition_point(|&y| y <= yl + band);
         let d = left.get(i);
         let (mut b1, mut b2, mut j1) = (u32::MAX, u32::MAX, u32::MAX);
-        for &j in &order[lo..hi] {
-            let dist = distance_sq(d, right.get(j as usize));
+        for (s, &j) in order[lo..hi].iter().enumerate() {
+            let at = (lo + s) * dim;
+            let dist = distance_sq(d, &sorted[at..at + dim]);
             if dist < b1 {
                 b2 = b1;
                 b1 = dist;

@@ -18,8 +18,8 @@ use nalgebra::Matrix2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::essential::constrained::VergeAngles;
-use crate::essential::{sampson_residual, Correspondence, EssentialError};
+use crate::essential::constrained::{residual, VergeAngles};
+use crate::essential::{Correspondence, EssentialError};
 
 /// Matches in a minimal sample of the constrained model.
 pub const MINIMAL_SAMPLE: usize = 2;
@@ -163,11 +163,11 @@ pub fn ransac(
             if h.alpha_l.abs() > config.max_abs_angle || h.alpha_r.abs() > config.max_abs_angle {
                 continue;
             }
-            let e = h.essential();
+            let e = h.unknowns();
             let mut cost = 0.0;
             let mut count = 0usize;
             for c in matches {
-                let r = sampson_residual(&e, c);
+                let r = residual(&e, c);
                 let r2 = r * r;
                 if r2 < thr2 {
                     count += 1;
@@ -192,10 +192,10 @@ pub fn ransac(
         }
     }
     let (_, angles) = best.ok_or(EssentialError::Degenerate)?;
-    let e = angles.essential();
+    let e = angles.unknowns();
     let inliers: Vec<bool> = matches
         .iter()
-        .map(|c| sampson_residual(&e, c).abs() < config.threshold)
+        .map(|c| residual(&e, c).abs() < config.threshold)
         .collect();
     let inlier_count = inliers.iter().filter(|&&b| b).count();
     Ok(RansacResult {

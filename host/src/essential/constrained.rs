@@ -6,7 +6,7 @@
 
 use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
 
-use super::{mad_sigma, rot_y, skew, Correspondence, EssentialError, RefineConfig};
+use super::{mad_sigma, Correspondence, EssentialError, RefineConfig};
 
 /// The two camera yaws of a verging head, in radians (ARCHITECTURE.md signs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -173,32 +173,51 @@ impl ConstrainedFit {
     }
 }
 
-/// Residual and its gradient with respect to (alpha_l, alpha_r) for one match.
-fn residual_and_jacobian(
-    e: &Matrix3<f64>,
-    de_l: &Matrix3<f64>,
-    de_r: &Matrix3<f64>,
-    c: &Correspondence,
-) -> Option<(f64, Vector2<f64>)> {
-    let xl = c.left_h();
-    let xr = c.right_h();
-    let ex = e * xl;
-    let etx = e.transpose() * xr;
-    let n = xr.dot(&ex);
-    let d = ex[0] * ex[0] + ex[1] * ex[1] + etx[0] * etx[0] + etx[1] * etx[1];
+/// Sampson residual of one match for the unknowns `e`, written out for the sparse structure
+/// of E (the hot loop of RANSAC scoring and of the refinement).
+#[inline]
+pub fn residual(e: &[f64; 4], c: &Correspondence) -> f64 {
+    let [ul, vl] = c.left;
+    let [ur, vr] = c.right;
+    let [e1, e2, e3, e4] = *e;
+    let ex1 = e2 * ul + e4;
+    let etx1 = e1 * ur + e3;
+    let n = ur * e1 * vl + vr * ex1 + e3 * vl;
+    let d = (e1 * vl).powi(2) + ex1 * ex1 + (e2 * vr).powi(2) + etx1 * etx1;
+    if d > 0.0 {
+        n / d.sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// Sampson residual and its gradient with respect to (alpha_l, alpha_r). With
+/// `e = (-sin a_r, sin a_l, cos a_r, -cos a_l)`: `∂e/∂a_l = (0, -e4, 0, e2)` and
+/// `∂e/∂a_r = (-e3, 0, e1, 0)`.
+#[inline]
+fn residual_and_gradient(e: &[f64; 4], c: &Correspondence) -> Option<(f64, Vector2<f64>)> {
+    let [ul, vl] = c.left;
+    let [ur, vr] = c.right;
+    let [e1, e2, e3, e4] = *e;
+    let ex0 = e1 * vl;
+    let ex1 = e2 * ul + e4;
+    let etx0 = e2 * vr;
+    let etx1 = e1 * ur + e3;
+    let n = ur * ex0 + vr * ex1 + e3 * vl;
+    let d = ex0 * ex0 + ex1 * ex1 + etx0 * etx0 + etx1 * etx1;
     if d <= 0.0 {
         return None;
     }
     let sd = d.sqrt();
-    let mut grad = Vector2::zeros();
-    for (k, de) in [de_l, de_r].into_iter().enumerate() {
-        let dex = de * xl;
-        let detx = de.transpose() * xr;
-        let dn = xr.dot(&dex);
-        let dd = 2.0 * (ex[0] * dex[0] + ex[1] * dex[1] + etx[0] * detx[0] + etx[1] * detx[1]);
-        grad[k] = dn / sd - 0.5 * n * dd / (d * sd);
-    }
-    Some((n / sd, grad))
+    // Along a_l.
+    let dex1 = -e4 * ul + e2;
+    let dn_l = vr * dex1;
+    let dd_l = 2.0 * (ex1 * dex1 + etx0 * (-e4 * vr));
+    // Along a_r.
+    let dn_r = vl * (e1 - e3 * ur);
+    let dd_r = 2.0 * (ex0 * (-e3 * vl) + etx1 * (-e3 * ur + e1));
+    let g = |dn: f64, dd: f64| dn / sd - 0.5 * n * dd / (d * sd);
+    Some((n / sd, Vector2::new(g(dn_l, dd_l), g(dn_r, dd_r))))
 }
 
 /// Robust Gauss-Newton (IRLS) refinement of (alpha_l, alpha_r) on the Sampson error of all
@@ -222,12 +241,9 @@ pub fn refine(
     let mut iterations = 0;
     for it in 0..config.max_iterations.max(1) {
         iterations = it + 1;
-        let e = angles.essential();
-        let t = Vector3::x();
-        let de_l = rot_y(angles.alpha_r).transpose() * skew(&t) * d_rot_y(angles.alpha_l);
-        let de_r = d_rot_y(angles.alpha_r).transpose() * skew(&t) * rot_y(angles.alpha_l);
+        let e = angles.unknowns();
         for (i, c) in matches.iter().enumerate() {
-            let (r, g) = residual_and_jacobian(&e, &de_l, &de_r, c).unwrap_or_default();
+            let (r, g) = residual_and_gradient(&e, c).unwrap_or_default();
             residuals[i] = r;
             jac[i] = g;
         }
@@ -248,17 +264,18 @@ pub fn refine(
         if !(angles.alpha_l.is_finite() && angles.alpha_r.is_finite()) {
             return Err(EssentialError::Degenerate);
         }
-        if step.norm() < 1e-12 {
+        // 1e-10 rad is 6e-9°: far below any accuracy that matters.
+        if step.norm() < 1e-10 {
             break;
         }
     }
     let cov = info.try_inverse().ok_or(EssentialError::Degenerate)? * sigma * sigma;
     let verge_var = cov[(0, 0)] + cov[(1, 1)] - 2.0 * cov[(0, 1)];
-    let e = angles.essential();
+    let e = angles.unknowns();
     let limit = config.inlier_sigmas * sigma;
     let inliers = matches
         .iter()
-        .map(|c| super::sampson_residual(&e, c).abs() < limit)
+        .map(|c| residual(&e, c).abs() < limit)
         .collect();
     Ok(ConstrainedFit {
         angles,
@@ -269,17 +286,30 @@ pub fn refine(
     })
 }
 
-/// d/da Ry(a).
-fn d_rot_y(a: f64) -> Matrix3<f64> {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(-s, 0.0, c, 0.0, 0.0, 0.0, -c, 0.0, -s)
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::testutil::synthetic;
-    use super::super::{sampson_residual, RobustLoss};
+    use super::super::{rot_y, sampson_residual, skew, RobustLoss};
     use super::*;
+
+    #[test]
+    fn sparse_residual_and_gradient_match_the_matrix_form() {
+        let a = VergeAngles::new(0.04, -0.02);
+        let m = synthetic(rot_y(0.05), rot_y(-0.01), 0.3, 20, 2.0, 700.0, 4);
+        let h = 1e-7;
+        for c in &m {
+            let (r, g) = residual_and_gradient(&a.unknowns(), c).unwrap();
+            assert!((r - sampson_residual(&a.essential(), c)).abs() < 1e-15);
+            assert!((r - residual(&a.unknowns(), c)).abs() < 1e-15);
+            let num = |dl: f64, dr: f64| {
+                let p = VergeAngles::new(a.alpha_l + dl, a.alpha_r + dr);
+                let q = VergeAngles::new(a.alpha_l - dl, a.alpha_r - dr);
+                (sampson_residual(&p.essential(), c) - sampson_residual(&q.essential(), c)) / (2.0 * h)
+            };
+            assert!((g[0] - num(h, 0.0)).abs() < 1e-6, "{} vs {}", g[0], num(h, 0.0));
+            assert!((g[1] - num(0.0, h)).abs() < 1e-6, "{} vs {}", g[1], num(0.0, h));
+        }
+    }
 
     #[test]
     fn essential_matches_the_derivation() {

@@ -1,0 +1,174 @@
+//! Per-frame-pair cost of the host estimator at 500 keypoints per image.
+//!
+//! `match+E+RANSAC+Kalman` is the budgeted part (≤ 1 ms): matching of precomputed descriptors,
+//! calibrated coordinates, RANSAC, the robust constrained refinement and a Kalman step.
+//! Descriptors, the sub-pixel refinement and the whole estimate are measured separately.
+//! The frames are synthetic (a textured gradient field seen by two cameras 9 px apart), so the
+//! benchmark needs no data files.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::hint::black_box;
+use stereocal::calib::{Calibration, CameraIntrinsics};
+use stereocal::descriptor::{describe, DescriptorConfig};
+use stereocal::estimator::{EstimatorConfig, VergeEstimator};
+use stereocal::frame::{FeatureFrame, Gradients, Keypoint, SobelPlane};
+use stereocal::kalman::{KalmanConfig, Measurement, VergeFilter};
+use stereocal::matching::{match_descriptors, MatchConfig};
+use stereocal::subpixel::{refine_pair, SubpixelConfig};
+
+const W: u32 = 640;
+const H: u32 = 480;
+const KEYPOINTS: usize = 500;
+const DISPARITY: i32 = 9;
+
+/// A smooth random gradient field; `shift` moves the content left by that many pixels.
+fn plane(seed: u64, shift: i32) -> SobelPlane {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let waves: Vec<(f32, f32, f32, f32)> = (0..12)
+        .map(|_| {
+            (
+                rng.random_range(0.05..0.6),
+                rng.random_range(0.05..0.6),
+                rng.random_range(0.0..6.28),
+                rng.random_range(10.0..30.0),
+            )
+        })
+        .collect();
+    let mut mag = Vec::with_capacity((W * H) as usize);
+    let mut ori = Vec::with_capacity((W * H) as usize);
+    for y in 0..H as i32 {
+        for x in 0..W as i32 {
+            let xs = (x + shift) as f32;
+            let v: f32 = waves
+                .iter()
+                .map(|(a, b, p, amp)| amp * (a * xs + b * y as f32 + p).sin())
+                .sum();
+            mag.push((v.abs() * 0.8).min(255.0) as u8);
+            ori.push(((v * 3.0).rem_euclid(64.0)) as u8);
+        }
+    }
+    SobelPlane::new(0, W, H, mag, ori).expect("plane size")
+}
+
+fn frames() -> (FeatureFrame, FeatureFrame) {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut left = Vec::new();
+    let mut right = Vec::new();
+    for _ in 0..KEYPOINTS {
+        let x: f32 = rng.random_range(30.0..(W as f32 - 30.0));
+        let y: f32 = rng.random_range(20.0..(H as f32 - 20.0));
+        let k = Keypoint {
+            x,
+            y,
+            octave: 0,
+            scale: 1.0,
+            dog: 5.0,
+        };
+        left.push(k);
+        right.push(Keypoint {
+            x: x - DISPARITY as f32,
+            ..k
+        });
+    }
+    let lf = FeatureFrame::new(0, 0, W, H, left, Gradients::Planes(vec![plane(7, 0)]));
+    let rf = FeatureFrame::new(0, 0, W, H, right, Gradients::Planes(vec![plane(7, DISPARITY)]));
+    (lf.expect("left frame"), rf.expect("right frame"))
+}
+
+fn bench(c: &mut Criterion) {
+    let (lf, rf) = frames();
+    let cam = CameraIntrinsics::pinhole(600.0, 600.0, W as f64 / 2.0, H as f64 / 2.0);
+    let calib = Calibration {
+        baseline_m: 0.3,
+        left: cam,
+        right: cam,
+    };
+    let config = EstimatorConfig::default();
+    let estimator = VergeEstimator::new(calib, config);
+    let dl = describe(&lf, &DescriptorConfig::default());
+    let dr = describe(&rf, &DescriptorConfig::default());
+    let matches = match_descriptors(&dl, lf.keypoints(), &dr, rf.keypoints(), &MatchConfig::default());
+    assert!(matches.len() > 300, "{} matches", matches.len());
+    let pairs: Vec<([f64; 2], [f64; 2])> = matches
+        .iter()
+        .map(|m| {
+            let a = lf.keypoints()[m.left as usize];
+            let b = rf.keypoints()[m.right as usize];
+            ([a.x as f64, a.y as f64], [b.x as f64, b.y as f64])
+        })
+        .collect();
+
+    c.bench_function("describe 2x500 (128)", |b| {
+        b.iter(|| {
+            (
+                describe(black_box(&lf), &DescriptorConfig::default()),
+                describe(black_box(&rf), &DescriptorConfig::default()),
+            )
+        })
+    });
+    c.bench_function("match+E+RANSAC+Kalman", |b| {
+        let mut t = 0u64;
+        let mut filter = VergeFilter::new(KalmanConfig::default());
+        b.iter(|| {
+            let m = match_descriptors(
+                black_box(&dl),
+                lf.keypoints(),
+                black_box(&dr),
+                rf.keypoints(),
+                &config.matching,
+            );
+            let p: Vec<([f64; 2], [f64; 2])> = m
+                .iter()
+                .map(|m| {
+                    let a = lf.keypoints()[m.left as usize];
+                    let b = rf.keypoints()[m.right as usize];
+                    ([a.x as f64, a.y as f64], [b.x as f64, b.y as f64])
+                })
+                .collect();
+            let est = estimator.estimate_from_pixels(&p).ok();
+            t += 33_333;
+            filter
+                .step(
+                    t,
+                    est.map(|e| Measurement {
+                        verge_deg: e.verge_deg,
+                        sigma_deg: e.sigma_deg,
+                    }),
+                )
+                .ok()
+        })
+    });
+    c.bench_function("match only", |b| {
+        b.iter(|| {
+            match_descriptors(black_box(&dl), lf.keypoints(), black_box(&dr), rf.keypoints(), &config.matching)
+        })
+    });
+    c.bench_function("E+RANSAC+refine only", |b| {
+        b.iter(|| estimator.estimate_from_pixels(black_box(&pairs)).ok())
+    });
+    c.bench_function("subpixel refine (all matches)", |b| {
+        let (pl, pr) = (lf.plane(0).expect("plane"), rf.plane(0).expect("plane"));
+        b.iter(|| {
+            pairs
+                .iter()
+                .filter_map(|(l, r)| {
+                    refine_pair(
+                        pl,
+                        pr,
+                        [l[0] as f32, l[1] as f32],
+                        [r[0] as f32, r[1] as f32],
+                        &SubpixelConfig::default(),
+                    )
+                })
+                .count()
+        })
+    });
+    c.bench_function("full estimate (describe+match+subpixel+RANSAC+refine)", |b| {
+        b.iter(|| estimator.estimate(black_box(&lf), black_box(&rf)).ok())
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
