@@ -112,3 +112,5 @@ impl core::fmt::Display for ConfigError {
         }
     }
 }
+
+impl core::error::Error for ConfigError {}

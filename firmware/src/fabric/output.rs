@@ -246,3 +246,5 @@ pub fn run_frame<F: FrontEnd + ?Sized>(
     }
     Err(FrameError::FlushTimeout)
 }
+
+impl core::error::Error for FrameError {}
