@@ -2,10 +2,12 @@
 
 pub mod calib;
 pub mod descriptor;
+pub mod driver;
 pub mod essential;
 pub mod estimator;
 pub mod frame;
 pub mod kalman;
+pub mod link;
 pub mod matching;
 pub mod ransac;
 pub mod subpixel;

@@ -1,0 +1,507 @@
+//! Decoded packets in, camera frames out: the receiving state machine of the driver.
+//!
+//! Link-independent and synchronous, so every damage case is tested with hand-built packet
+//! sequences. One frame is assembled at a time (the soft-core sends a camera frame's packets
+//! contiguously, log packets aside). A frame is *damaged* when a packet of it may be
+//! missing (a sequence gap or an undecodable frame while it is open, a `FrameStart` before
+//! its `FrameEnd`, no `FrameStart` at all) or when its contents are inconsistent; a damaged
+//! frame is consumed up to its end, reported once and dropped. The next `FrameStart` always
+//! starts afresh, which is the resynchronisation.
+
+use std::collections::VecDeque;
+
+use stereocal_hdl::regs;
+use stereocal_wire::{
+    Camera, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr, Header, HelloRepr,
+    PacketKind, PacketRepr, Point, RegisterValueRepr,
+};
+
+use super::damage::{ContentError, Damage, PacketRef};
+use super::gradients::{FinishError, GradientBuilder};
+use super::keypoint::keypoint;
+use super::stats::LinkStats;
+use stereocal_firmware::fabric::geometry::octave_dims;
+use crate::frame::{FeatureFrame, Keypoint};
+
+/// A camera frame that arrived complete and consistent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReceivedFrame {
+    /// Frame number from the device.
+    pub frame_id: u32,
+    /// Which camera.
+    pub camera: Camera,
+    /// Keypoints (full-resolution pixels) and gradients.
+    pub features: FeatureFrame,
+    /// Octaves the device computed.
+    pub octaves: u8,
+    /// Link bytes of the frame's packets, `FrameStart` through `FrameEnd` (COBS and
+    /// delimiters included, interleaved log packets excluded).
+    pub wire_bytes: u64,
+    /// Packets of the frame.
+    pub packets: u32,
+    /// Points the fabric's FIFO could not hold (from `FrameEnd`).
+    pub dropped_points: u32,
+    /// Sobel records the fabric or the soft-core could not hold (from `FrameEnd`).
+    pub dropped_sobel: u32,
+    /// FIFO overflow flags (from `FrameEnd`).
+    pub flags: FrameEndFlags,
+    /// Points left out of `features` because their patch never came (patches mode).
+    pub points_without_patch: u32,
+}
+
+/// A camera frame that was dropped.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DamagedFrame {
+    /// Frame number.
+    pub frame_id: u32,
+    /// Which camera.
+    pub camera: Camera,
+    /// The first problem found.
+    pub damage: Damage,
+    /// Link bytes of the packets that arrived for it.
+    pub wire_bytes: u64,
+}
+
+/// What became of one camera frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FrameOutcome {
+    /// Assembled.
+    Delivered(Box<ReceivedFrame>),
+    /// Dropped, with the reason.
+    Damaged(DamagedFrame),
+}
+
+impl FrameOutcome {
+    /// Frame number.
+    pub fn frame_id(&self) -> u32 {
+        match self {
+            Self::Delivered(f) => f.frame_id,
+            Self::Damaged(f) => f.frame_id,
+        }
+    }
+
+    /// Camera.
+    pub fn camera(&self) -> Camera {
+        match self {
+            Self::Delivered(f) => f.camera,
+            Self::Damaged(f) => f.camera,
+        }
+    }
+
+    /// Link bytes of the frame.
+    pub fn wire_bytes(&self) -> u64 {
+        match self {
+            Self::Delivered(f) => f.wire_bytes,
+            Self::Damaged(f) => f.wire_bytes,
+        }
+    }
+
+    /// The frame, if it was delivered.
+    pub fn delivered(self) -> Option<ReceivedFrame> {
+        match self {
+            Self::Delivered(f) => Some(*f),
+            Self::Damaged(_) => None,
+        }
+    }
+}
+
+/// One defmt log frame from the device, undecoded.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LogFrame {
+    /// Sequence number of its packet.
+    pub seq: u16,
+    /// The defmt frame bytes (decode with the firmware ELF's defmt table).
+    pub bytes: Vec<u8>,
+}
+
+/// What one packet amounted to.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Event {
+    Frame(FrameOutcome),
+    Hello(HelloRepr),
+    RegisterValue(RegisterValueRepr),
+    Log(LogFrame),
+    DeviceError { seq: u16, report: ErrorReportRepr },
+}
+
+/// The frame being assembled.
+#[derive(Debug)]
+struct Partial {
+    frame_id: u32,
+    camera: Camera,
+    /// `None` when the `FrameStart` was lost (the frame is damaged then).
+    start: Option<FrameStartRepr>,
+    damage: Option<Damage>,
+    wire_bytes: u64,
+    packets: u32,
+    points: Vec<Point>,
+    keypoints: Vec<Keypoint>,
+    sobel_packets: u32,
+    gradients: GradientBuilder,
+}
+
+impl Partial {
+    fn new(frame_id: u32, camera: Camera, start: Option<FrameStartRepr>) -> Self {
+        Self {
+            frame_id,
+            camera,
+            start,
+            damage: None,
+            wire_bytes: 0,
+            packets: 0,
+            points: Vec::new(),
+            keypoints: Vec::new(),
+            sobel_packets: 0,
+            gradients: GradientBuilder::Empty,
+        }
+    }
+
+    fn damage(&mut self, damage: Damage) {
+        self.damage.get_or_insert(damage);
+    }
+}
+
+/// The receiving state machine.
+#[derive(Debug, Default)]
+pub(crate) struct FrameAssembler {
+    last_seq: Option<u16>,
+    partial: Option<Partial>,
+    events: VecDeque<Event>,
+    pub stats: LinkStats,
+}
+
+/// The frame id and camera a frame-body packet carries.
+fn body_ids(packet: &PacketRepr<'_>) -> Option<(u32, Camera)> {
+    match packet {
+        PacketRepr::PointBatch(p) => Some((p.frame_id, p.camera)),
+        PacketRepr::SobelRows(p) => Some((p.frame_id, p.camera)),
+        PacketRepr::SobelPatch(p) => Some((p.frame_id, p.camera)),
+        PacketRepr::FrameEnd(p) => Some((p.frame_id, p.camera)),
+        _ => None,
+    }
+}
+
+/// Why a `FrameStart` describes a frame the fabric cannot produce (and the host will not
+/// allocate planes for).
+fn geometry_problem(start: &FrameStartRepr) -> Option<ContentError> {
+    let fits = start.octaves >= 1
+        && u32::from(start.octaves) <= regs::MAX_OCTAVES
+        && start.width >= 1
+        && u32::from(start.width) <= regs::MAX_WIDTH
+        && start.height >= 1
+        && u32::from(start.height) <= regs::MAX_HEIGHT;
+    (!fits).then_some(ContentError::BadGeometry {
+        width: start.width,
+        height: start.height,
+        octaves: start.octaves,
+    })
+}
+
+/// Adds a points or Sobel packet to an undamaged frame.
+fn add_body(p: &mut Partial, packet: &PacketRepr<'_>) -> Result<(), ContentError> {
+    // Only undamaged frames get here, and those have their FrameStart.
+    let Some(start) = p.start else {
+        return Ok(());
+    };
+    match packet {
+        PacketRepr::PointBatch(batch) => {
+            for (index, point) in batch.points.iter().enumerate() {
+                if point.octave >= start.octaves {
+                    return Err(ContentError::Octave {
+                        octave: point.octave,
+                        octaves: start.octaves,
+                    });
+                }
+                let (w, h) = octave_dims(start.width, start.height, point.octave);
+                if point.x >= w || point.y >= h {
+                    return Err(ContentError::PointOutside {
+                        index,
+                        octave: point.octave,
+                        x: point.x,
+                        y: point.y,
+                        width: w,
+                        height: h,
+                    });
+                }
+                p.points.push(point);
+                p.keypoints.push(keypoint(&point));
+            }
+            Ok(())
+        }
+        PacketRepr::SobelRows(row) => {
+            p.sobel_packets += 1;
+            p.gradients
+                .add_row(row, start.width, start.height, start.octaves)
+        }
+        PacketRepr::SobelPatch(patch) => {
+            p.sobel_packets += 1;
+            p.gradients.add_patch(patch, start.octaves)
+        }
+        _ => Ok(()),
+    }
+}
+
+impl FrameAssembler {
+    /// The next thing that happened, oldest first.
+    pub fn pop_event(&mut self) -> Option<Event> {
+        self.events.pop_front()
+    }
+
+    /// The frame in progress: id, camera and packets so far.
+    pub fn in_progress(&self) -> Option<(u32, Camera, u32)> {
+        self.partial
+            .as_ref()
+            .map(|p| (p.frame_id, p.camera, p.packets))
+    }
+
+    /// A link frame that did not decode; `wire_len` is the bytes it took.
+    pub fn undecodable(&mut self, error: stereocal_wire::Error, wire_len: usize) {
+        self.stats.undecodable += 1;
+        let after_seq = self.last_seq.unwrap_or(0);
+        if let Some(p) = &mut self.partial {
+            p.wire_bytes += wire_len as u64;
+            p.damage(Damage::Undecodable { after_seq, error });
+        }
+    }
+
+    /// A link frame longer than any packet.
+    pub fn over_long(&mut self, wire_len: usize) {
+        self.stats.over_long += 1;
+        let after_seq = self.last_seq.unwrap_or(0);
+        if let Some(p) = &mut self.partial {
+            p.wire_bytes += wire_len as u64;
+            p.damage(Damage::OverLong { after_seq });
+        }
+    }
+
+    /// Checks the sequence number; returns the expected one when it jumped.
+    fn check_seq(&mut self, seq: u16) -> Option<u16> {
+        let gap = match self.last_seq {
+            Some(last) if seq != last.wrapping_add(1) => {
+                let expected = last.wrapping_add(1);
+                self.stats.sequence_gaps += 1;
+                self.stats.packets_lost += u64::from(seq.wrapping_sub(expected));
+                Some(expected)
+            }
+            _ => None,
+        };
+        self.last_seq = Some(seq);
+        gap
+    }
+
+    /// A decoded packet; `wire_len` is the link bytes it took (delimiter and any noise
+    /// before it included).
+    pub fn packet(&mut self, header: &Header, packet: &PacketRepr<'_>, wire_len: usize) {
+        self.stats.packets += 1;
+        let seq = header.seq;
+        if let PacketRepr::Hello(hello) = packet {
+            // A device that says Hello has (re)started: its numbering starts over, and a
+            // frame it was sending will not be finished.
+            self.last_seq = Some(seq);
+            if let Some(p) = self.partial.take() {
+                let next = PacketRef {
+                    kind: header.kind,
+                    seq,
+                    frame_id: p.frame_id,
+                    camera: p.camera,
+                };
+                self.close_damaged(p, Damage::Truncated { next });
+            }
+            self.events.push_back(Event::Hello(*hello));
+            return;
+        }
+        let gap = self.check_seq(seq);
+        // A gap inside a frame may have swallowed any of its packets.
+        if let (Some(expected), Some(p)) = (gap, &mut self.partial) {
+            p.damage(Damage::SequenceGap {
+                expected,
+                got: seq,
+                kind: header.kind,
+            });
+        }
+        match packet {
+            PacketRepr::Log(log) => {
+                self.stats.log_frames += 1;
+                self.events.push_back(Event::Log(LogFrame {
+                    seq,
+                    bytes: log.frame.to_vec(),
+                }));
+            }
+            PacketRepr::RegisterValue(v) => self.events.push_back(Event::RegisterValue(*v)),
+            PacketRepr::ErrorReport(report) => {
+                self.stats.device_errors += 1;
+                self.events.push_back(Event::DeviceError {
+                    seq,
+                    report: *report,
+                });
+            }
+            PacketRepr::FrameStart(start) => {
+                let this = PacketRef {
+                    kind: header.kind,
+                    seq,
+                    frame_id: start.frame_id,
+                    camera: start.camera,
+                };
+                if let Some(previous) = self.partial.take() {
+                    self.close_damaged(previous, Damage::Truncated { next: this });
+                }
+                let mut fresh = Partial::new(start.frame_id, start.camera, Some(*start));
+                fresh.wire_bytes = wire_len as u64;
+                fresh.packets = 1;
+                if let Some(problem) = geometry_problem(start) {
+                    fresh.damage(Damage::Content {
+                        packet: this,
+                        problem,
+                    });
+                }
+                self.partial = Some(fresh);
+            }
+            PacketRepr::PointBatch(_)
+            | PacketRepr::SobelRows(_)
+            | PacketRepr::SobelPatch(_)
+            | PacketRepr::FrameEnd(_) => self.body(header, packet, wire_len),
+            PacketRepr::Hello(_) | PacketRepr::RegisterWrite(_) | PacketRepr::RegisterRead(_) => {
+                // Host-to-device kinds: a loopback or a confused peer.
+                self.stats.stray_packets += 1;
+            }
+        }
+    }
+
+    /// A packet of a frame's body (points, Sobel, end).
+    fn body(&mut self, header: &Header, packet: &PacketRepr<'_>, wire_len: usize) {
+        let Some((frame_id, camera)) = body_ids(packet) else {
+            return;
+        };
+        let this = PacketRef {
+            kind: header.kind,
+            seq: header.seq,
+            frame_id,
+            camera,
+        };
+        let belongs = self
+            .partial
+            .as_ref()
+            .map(|p| (p.frame_id, p.camera) == (frame_id, camera));
+        if belongs == Some(false) {
+            // Another frame's packet: this frame lost its end, the other its start.
+            if let Some(previous) = self.partial.take() {
+                self.close_damaged(previous, Damage::Foreign { packet: this });
+            }
+        }
+        let p = self.partial.get_or_insert_with(|| {
+            let mut headless = Partial::new(frame_id, camera, None);
+            headless.damage(Damage::MissingStart { first: this });
+            headless
+        });
+        p.wire_bytes += wire_len as u64;
+        p.packets += 1;
+        if p.damage.is_none() {
+            if let Err(problem) = add_body(p, packet) {
+                p.damage(Damage::Content {
+                    packet: this,
+                    problem,
+                });
+            }
+        }
+        if let PacketRepr::FrameEnd(end) = packet {
+            if let Some(p) = self.partial.take() {
+                self.close(p, header.seq, end);
+            }
+        }
+    }
+
+    /// Reports a dropped frame.
+    fn close_damaged(&mut self, p: Partial, damage: Damage) {
+        let damage = p.damage.clone().unwrap_or(damage);
+        self.stats.frames_damaged += 1;
+        self.stats.damage.count(&damage);
+        self.events.push_back(Event::Frame(FrameOutcome::Damaged(DamagedFrame {
+            frame_id: p.frame_id,
+            camera: p.camera,
+            damage,
+            wire_bytes: p.wire_bytes,
+        })));
+    }
+
+    /// Closes a frame at its `FrameEnd` (sequence number `seq`).
+    fn close(&mut self, mut p: Partial, seq: u16, end: &FrameEndRepr) {
+        let (Some(start), None) = (p.start, &p.damage) else {
+            let damage = p.damage.clone().unwrap_or(Damage::MissingStart {
+                first: PacketRef {
+                    kind: PacketKind::FrameEnd,
+                    seq,
+                    frame_id: p.frame_id,
+                    camera: p.camera,
+                },
+            });
+            return self.close_damaged(p, damage);
+        };
+        let points_received = p.points.len() as u64;
+        if u64::from(end.point_count) != points_received || end.sobel_count != p.sobel_packets {
+            let damage = Damage::CountMismatch {
+                seq,
+                points_announced: end.point_count,
+                points_received: points_received.min(u64::from(u32::MAX)) as u32,
+                sobel_announced: end.sobel_count,
+                sobel_received: p.sobel_packets,
+            };
+            return self.close_damaged(p, damage);
+        }
+        let points = std::mem::take(&mut p.points);
+        let keypoints = std::mem::take(&mut p.keypoints);
+        let gradients = std::mem::take(&mut p.gradients);
+        let finished = match gradients.finish(&points, keypoints) {
+            Ok(f) => f,
+            Err(FinishError::Content(problem)) => {
+                let packet = PacketRef {
+                    kind: PacketKind::FrameEnd,
+                    seq,
+                    frame_id: p.frame_id,
+                    camera: p.camera,
+                };
+                return self.close_damaged(p, Damage::Content { packet, problem });
+            }
+            Err(FinishError::Frame(error)) => {
+                let damage = Damage::Assembly {
+                    frame_id: p.frame_id,
+                    camera: p.camera,
+                    error,
+                };
+                return self.close_damaged(p, damage);
+            }
+        };
+        let features = match FeatureFrame::new(
+            u64::from(p.frame_id),
+            start.timestamp_us,
+            start.width.into(),
+            start.height.into(),
+            finished.keypoints,
+            finished.gradients,
+        ) {
+            Ok(f) => f,
+            Err(error) => {
+                let damage = Damage::Assembly {
+                    frame_id: p.frame_id,
+                    camera: p.camera,
+                    error,
+                };
+                return self.close_damaged(p, damage);
+            }
+        };
+        self.stats.frames_delivered += 1;
+        self.stats.delivered_wire_bytes += p.wire_bytes;
+        self.events
+            .push_back(Event::Frame(FrameOutcome::Delivered(Box::new(ReceivedFrame {
+                frame_id: p.frame_id,
+                camera: p.camera,
+                features,
+                octaves: start.octaves,
+                wire_bytes: p.wire_bytes,
+                packets: p.packets,
+                dropped_points: end.dropped_points,
+                dropped_sobel: end.dropped_sobel,
+                flags: end.flags,
+                points_without_patch: finished.without_patch,
+            }))));
+    }
+}

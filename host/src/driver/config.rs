@@ -1,0 +1,93 @@
+//! The register writes of a [`FabricConfig`] and what each register must read back.
+//!
+//! `FabricConfig::write_to` is the one definition of which fields go where; running it
+//! against an in-memory [`RegisterBank`] that records the bus writes turns it into wire
+//! `RegisterWrite` packets without restating the register map, and the bank's read-back
+//! (with the map's access rules: reserved bits read 0) is what the device must answer.
+
+use stereocal_hdl::{Error, FabricConfig, RegisterBank, RegisterBus};
+
+/// Register writes in order, then the registers to read back with their expected values.
+pub(crate) struct Plan {
+    pub writes: Vec<(u16, u32)>,
+    pub read_back: Vec<(u16, u32)>,
+}
+
+/// A bank that remembers the writes made through it.
+struct Recorder {
+    bank: RegisterBank,
+    writes: Vec<(u16, u32)>,
+}
+
+impl RegisterBus for Recorder {
+    fn read(&mut self, offset: u16) -> u32 {
+        self.bank.read(offset)
+    }
+
+    fn write(&mut self, offset: u16, value: u32) {
+        self.bank.write(offset, value);
+        self.writes.push((offset, value));
+    }
+}
+
+/// The writes `config` needs, validated first.
+pub(crate) fn plan(config: &FabricConfig) -> Result<Plan, Error> {
+    let mut recorder = Recorder {
+        bank: RegisterBank::new(),
+        writes: Vec::new(),
+    };
+    config.write_to(&mut recorder)?;
+    let mut read_back: Vec<(u16, u32)> = Vec::new();
+    for &(addr, _) in &recorder.writes {
+        if !read_back.iter().any(|&(a, _)| a == addr) {
+            read_back.push((addr, recorder.bank.read(addr)));
+        }
+    }
+    Ok(Plan {
+        writes: recorder.writes,
+        read_back,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stereocal_hdl::regs;
+
+    #[test]
+    fn plan_writes_every_configuration_register_once() {
+        let config = FabricConfig {
+            width: 320,
+            height: 240,
+            octaves: 3,
+            contrast_threshold: 5,
+            edge_ratio: 12,
+            sobel_output: regs::output_mode::SobelOutput::Rows,
+            sobel_scale: 2,
+        };
+        let plan = plan(&config).unwrap();
+        let offsets: Vec<u16> = plan.read_back.iter().map(|&(a, _)| a).collect();
+        assert_eq!(
+            offsets,
+            [
+                regs::width::OFFSET,
+                regs::height::OFFSET,
+                regs::octaves::OFFSET,
+                regs::contrast_threshold::OFFSET,
+                regs::edge_threshold::OFFSET,
+                regs::output_mode::OFFSET
+            ]
+        );
+        assert!(plan.read_back.contains(&(regs::width::OFFSET, 320)));
+        assert!(plan.read_back.contains(&(regs::output_mode::OFFSET, 2 << 4)));
+    }
+
+    #[test]
+    fn invalid_config_plans_nothing() {
+        let config = FabricConfig {
+            width: 322,
+            ..FabricConfig::default()
+        };
+        assert!(matches!(plan(&config), Err(Error::FrameNotDivisible { .. })));
+    }
+}

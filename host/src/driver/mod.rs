@@ -1,0 +1,404 @@
+//! The host side of the link: Hello, configuration, and camera frames reassembled from wire
+//! packets into [`FeatureFrame`](crate::frame::FeatureFrame)s.
+//!
+//! ```no_run
+//! # use std::time::Duration;
+//! # use stereocal::driver::{Driver, PairOutcome};
+//! # use stereocal::link::TcpLink;
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let mut driver = Driver::new(TcpLink::tcp("127.0.0.1:4444")?);
+//! let t = Duration::from_secs(2);
+//! driver.hello(t)?;
+//! driver.configure(&stereocal_hdl::FabricConfig::default(), t)?;
+//! match driver.next_pair(t)? {
+//!     PairOutcome::Pair { left, right } => { /* each Delivered or Damaged */ }
+//!     PairOutcome::Single(lone) => { /* its partner was lost without a trace */ }
+//! }
+//! println!("{:?}", driver.stats());
+//! # Ok(()) }
+//! ```
+//!
+//! Every byte the link delivers goes through one [`Accumulator`]; decoded packets go to the
+//! frame assembler (`assembler.rs`, the state machine with the damage rules). The driver
+//! only adds requests (Hello, register writes and reads), deadlines and queues.
+
+mod assembler;
+mod config;
+mod damage;
+mod error;
+mod gradients;
+mod keypoint;
+mod stats;
+
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+
+use stereocal_hdl::{regs, FabricConfig};
+use stereocal_wire::{
+    encode, Accumulator, Camera, ErrorReportRepr, FeedResult, HelloRepr, PacketRepr,
+    RegisterReadRepr, RegisterWriteRepr, MAX_FRAME_LEN, PROTOCOL_VERSION,
+};
+
+pub use assembler::{DamagedFrame, FrameOutcome, LogFrame, ReceivedFrame};
+pub use damage::{ContentError, Damage, DamageCounts, PacketRef};
+pub use error::{DriverError, Waiting};
+pub use keypoint::keypoint;
+pub use stats::LinkStats;
+
+use crate::link::{Link, LinkError};
+use assembler::{Event, FrameAssembler};
+
+/// Bytes asked of the link per receive call.
+const RECEIVE_CHUNK: usize = 64 * 1024;
+/// Log frames kept when nobody takes them; older ones are discarded and counted.
+const LOG_QUEUE_LIMIT: usize = 65_536;
+/// Capabilities the host announces: it takes everything the device can send.
+const HOST_CAPABILITIES: stereocal_wire::Capabilities = stereocal_wire::Capabilities(
+    stereocal_wire::Capabilities::POINTS.0
+        | stereocal_wire::Capabilities::SOBEL_ROWS.0
+        | stereocal_wire::Capabilities::SOBEL_PATCHES.0
+        | stereocal_wire::Capabilities::LOG.0
+        | stereocal_wire::Capabilities::REGISTERS.0,
+);
+
+/// Both cameras of one frame, or one camera whose partner left no trace.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PairOutcome {
+    /// Left and right of the same frame id, each delivered or damaged.
+    Pair {
+        /// The left camera's frame.
+        left: FrameOutcome,
+        /// The right camera's frame.
+        right: FrameOutcome,
+    },
+    /// A frame whose partner never arrived (or an unknown camera value).
+    Single(FrameOutcome),
+}
+
+impl PairOutcome {
+    /// The frame id.
+    pub fn frame_id(&self) -> u32 {
+        match self {
+            Self::Pair { left, .. } => left.frame_id(),
+            Self::Single(f) => f.frame_id(),
+        }
+    }
+
+    /// Link bytes of the pair (both frames, as received).
+    pub fn wire_bytes(&self) -> u64 {
+        match self {
+            Self::Pair { left, right } => left.wire_bytes() + right.wire_bytes(),
+            Self::Single(f) => f.wire_bytes(),
+        }
+    }
+
+    /// Both frames, when both were delivered.
+    pub fn delivered(self) -> Option<(ReceivedFrame, ReceivedFrame)> {
+        match self {
+            Self::Pair { left, right } => Some((left.delivered()?, right.delivered()?)),
+            Self::Single(_) => None,
+        }
+    }
+}
+
+/// An `ErrorReport` the device sent outside a request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DeviceReport {
+    /// Sequence number of the packet.
+    pub seq: u16,
+    /// The report.
+    pub report: ErrorReportRepr,
+}
+
+/// The host driver over a link `L`.
+pub struct Driver<L: Link> {
+    link: L,
+    accumulator: Box<Accumulator<{ MAX_FRAME_LEN - 1 }>>,
+    rx: Vec<u8>,
+    rx_pos: usize,
+    rx_len: usize,
+    /// Link bytes consumed since the last complete link frame.
+    wire_pending: usize,
+    assembler: FrameAssembler,
+    tx: Vec<u8>,
+    tx_seq: u16,
+    frames: VecDeque<FrameOutcome>,
+    pending_pair: Option<FrameOutcome>,
+    hellos: VecDeque<HelloRepr>,
+    register_values: VecDeque<(u16, u32)>,
+    device_errors: Vec<DeviceReport>,
+    logs: VecDeque<LogFrame>,
+}
+
+impl<L: Link> Driver<L> {
+    /// A driver over `link`; nothing is sent yet.
+    pub fn new(link: L) -> Self {
+        Self {
+            link,
+            accumulator: Box::new(Accumulator::new()),
+            rx: vec![0; RECEIVE_CHUNK],
+            rx_pos: 0,
+            rx_len: 0,
+            wire_pending: 0,
+            assembler: FrameAssembler::default(),
+            tx: vec![0; MAX_FRAME_LEN],
+            tx_seq: 0,
+            frames: VecDeque::new(),
+            pending_pair: None,
+            hellos: VecDeque::new(),
+            register_values: VecDeque::new(),
+            device_errors: Vec::new(),
+            logs: VecDeque::new(),
+        }
+    }
+
+    /// The link (e.g. to hand the in-process device its images).
+    pub fn link(&self) -> &L {
+        &self.link
+    }
+
+    /// The link, mutably.
+    pub fn link_mut(&mut self) -> &mut L {
+        &mut self.link
+    }
+
+    /// Gives the link back.
+    pub fn into_link(self) -> L {
+        self.link
+    }
+
+    /// Counters since the driver was created.
+    pub fn stats(&self) -> &LinkStats {
+        &self.assembler.stats
+    }
+
+    /// The device's log frames received so far (oldest first), emptying the queue.
+    pub fn take_logs(&mut self) -> Vec<LogFrame> {
+        self.logs.drain(..).collect()
+    }
+
+    /// `ErrorReport`s the device sent outside a request, emptying the list.
+    pub fn take_device_errors(&mut self) -> Vec<DeviceReport> {
+        std::mem::take(&mut self.device_errors)
+    }
+
+    /// Sends the host's `Hello` and waits for the device's (one already received counts).
+    pub fn hello(&mut self, timeout: Duration) -> Result<HelloRepr, DriverError> {
+        self.send(&PacketRepr::Hello(HelloRepr {
+            version: PROTOCOL_VERSION,
+            capabilities: HOST_CAPABILITIES,
+        }))?;
+        let deadline = Instant::now() + timeout;
+        let hello = loop {
+            if let Some(hello) = self.hellos.pop_front() {
+                break hello;
+            }
+            self.pump(deadline, timeout, Waiting::Hello)?;
+        };
+        if hello.version < PROTOCOL_VERSION {
+            return Err(DriverError::Version {
+                device: hello.version,
+                host: PROTOCOL_VERSION,
+            });
+        }
+        Ok(hello)
+    }
+
+    /// Writes one register (no answer expected).
+    pub fn write_register(&mut self, addr: u16, value: u32) -> Result<(), DriverError> {
+        self.send(&PacketRepr::RegisterWrite(RegisterWriteRepr { addr, value }))
+    }
+
+    /// Reads one register.
+    pub fn read_register(&mut self, addr: u16, timeout: Duration) -> Result<u32, DriverError> {
+        self.register_values.clear();
+        self.send(&PacketRepr::RegisterRead(RegisterReadRepr { addr }))?;
+        let deadline = Instant::now() + timeout;
+        let errors_before = self.device_errors.len();
+        loop {
+            if let Some(i) = self.register_values.iter().position(|&(a, _)| a == addr) {
+                let (_, value) = self.register_values.remove(i).unwrap_or((addr, 0));
+                return Ok(value);
+            }
+            if let Some(e) = self.device_errors.get(errors_before) {
+                let e = *e;
+                self.device_errors.truncate(errors_before);
+                return Err(DriverError::Device {
+                    code: e.report.code,
+                    detail: e.report.detail,
+                    seq: e.seq,
+                });
+            }
+            self.pump(deadline, timeout, Waiting::RegisterValue { addr })?;
+        }
+    }
+
+    /// Writes the fabric configuration (width, height, octaves, thresholds, output mode)
+    /// and reads every written register back. Nothing is sent when `config` is invalid.
+    pub fn configure(&mut self, config: &FabricConfig, timeout: Duration) -> Result<(), DriverError> {
+        let plan = config::plan(config).map_err(DriverError::Config)?;
+        for &(addr, value) in &plan.writes {
+            self.write_register(addr, value)?;
+        }
+        for &(addr, expected) in &plan.read_back {
+            let read = self.read_register(addr, timeout)?;
+            if read != expected {
+                return Err(DriverError::ReadBack {
+                    addr,
+                    written: expected,
+                    read,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets `CONTROL.ENABLE`: the device starts taking frames.
+    pub fn enable(&mut self) -> Result<(), DriverError> {
+        let value = regs::control::ENABLE
+            .insert(0, 1)
+            .map_err(DriverError::Config)?;
+        self.write_register(regs::control::OFFSET, value)
+    }
+
+    /// The next camera frame, delivered or damaged.
+    pub fn next_frame(&mut self, timeout: Duration) -> Result<FrameOutcome, DriverError> {
+        if let Some(frame) = self.pending_pair.take() {
+            return Ok(frame);
+        }
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(frame) = self.frames.pop_front() {
+                return Ok(frame);
+            }
+            let waiting = Waiting::Frame {
+                in_progress: self.assembler.in_progress(),
+            };
+            self.pump(deadline, timeout, waiting)?;
+        }
+    }
+
+    /// The next frame pair: frames are paired by frame id, left with right. A frame whose
+    /// partner left no trace (both its packets and its FrameStart were lost) comes alone.
+    pub fn next_pair(&mut self, timeout: Duration) -> Result<PairOutcome, DriverError> {
+        let deadline = Instant::now() + timeout;
+        let first = self.next_frame(timeout)?;
+        if !matches!(first.camera(), Camera::Left | Camera::Right) {
+            return Ok(PairOutcome::Single(first));
+        }
+        let second = self.next_frame(deadline.saturating_duration_since(Instant::now()))?;
+        let partners = second.frame_id() == first.frame_id()
+            && matches!(
+                (first.camera(), second.camera()),
+                (Camera::Left, Camera::Right) | (Camera::Right, Camera::Left)
+            );
+        if !partners {
+            self.pending_pair = Some(second);
+            return Ok(PairOutcome::Single(first));
+        }
+        let (left, right) = if first.camera() == Camera::Left {
+            (first, second)
+        } else {
+            (second, first)
+        };
+        Ok(PairOutcome::Pair { left, right })
+    }
+
+    /// Encodes and sends one request.
+    fn send(&mut self, packet: &PacketRepr<'_>) -> Result<(), DriverError> {
+        let frame = encode(self.tx_seq, packet, &mut self.tx).map_err(DriverError::Encode)?;
+        self.link.send(frame).map_err(DriverError::Link)?;
+        self.assembler.stats.bytes_sent += frame.len() as u64;
+        self.tx_seq = self.tx_seq.wrapping_add(1);
+        Ok(())
+    }
+
+    /// Decodes buffered bytes, or receives more, until at least one event was sorted into
+    /// its queue.
+    fn pump(&mut self, deadline: Instant, timeout: Duration, waiting: Waiting) -> Result<(), DriverError> {
+        loop {
+            if self.decode_buffered() {
+                return Ok(());
+            }
+            match self.link.recv(&mut self.rx, deadline) {
+                Ok(n) => {
+                    self.rx_pos = 0;
+                    self.rx_len = n.min(self.rx.len());
+                    self.assembler.stats.bytes_received += self.rx_len as u64;
+                }
+                Err(LinkError::Timeout { .. }) => {
+                    return Err(DriverError::Timeout {
+                        waiting_for: waiting,
+                        timeout,
+                    })
+                }
+                Err(e) => return Err(DriverError::Link(e)),
+            }
+        }
+    }
+
+    /// Feeds buffered bytes to the accumulator until an event comes out or the buffer is
+    /// empty; returns whether an event came out.
+    fn decode_buffered(&mut self) -> bool {
+        while self.rx_pos < self.rx_len {
+            let input = &self.rx[self.rx_pos..self.rx_len];
+            let (rest_len, frame_len) = match self.accumulator.feed(input) {
+                FeedResult::Consumed => (0, None),
+                FeedResult::OverFull(rest) => {
+                    let wire = self.wire_pending + input.len() - rest.len();
+                    self.assembler.over_long(wire);
+                    (rest.len(), Some(wire))
+                }
+                FeedResult::DecodeError { error, remaining } => {
+                    let wire = self.wire_pending + input.len() - remaining.len();
+                    self.assembler.undecodable(error, wire);
+                    (remaining.len(), Some(wire))
+                }
+                FeedResult::Success {
+                    header,
+                    packet,
+                    remaining,
+                } => {
+                    let wire = self.wire_pending + input.len() - remaining.len();
+                    self.assembler.packet(&header, &packet, wire);
+                    (remaining.len(), Some(wire))
+                }
+            };
+            let consumed = self.rx_len - self.rx_pos - rest_len;
+            // Bytes of a link frame that is not complete yet count towards that frame.
+            self.wire_pending = match frame_len {
+                Some(_) => 0,
+                None => self.wire_pending + consumed,
+            };
+            self.rx_pos = self.rx_len - rest_len;
+            if self.sort_events() {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Moves the assembler's events into the driver's queues; whether there were any.
+    fn sort_events(&mut self) -> bool {
+        let mut any = false;
+        while let Some(event) = self.assembler.pop_event() {
+            any = true;
+            match event {
+                Event::Frame(f) => self.frames.push_back(f),
+                Event::Hello(h) => self.hellos.push_back(h),
+                Event::RegisterValue(v) => self.register_values.push_back((v.addr, v.value)),
+                Event::Log(log) => {
+                    if self.logs.len() >= LOG_QUEUE_LIMIT {
+                        self.logs.pop_front();
+                        self.assembler.stats.logs_discarded += 1;
+                    }
+                    self.logs.push_back(log);
+                }
+                Event::DeviceError { seq, report } => {
+                    self.device_errors.push(DeviceReport { seq, report })
+                }
+            }
+        }
+        any
+    }
+}

@@ -1,0 +1,69 @@
+//! Byte links between the host and the device: one small trait, one implementation per
+//! transport.
+//!
+//! A link moves opaque bytes; framing, CRCs and sequence numbers are the wire format's and
+//! the [`driver`](crate::driver)'s business. Keeping the trait at two methods (and object-safe)
+//! lets the driver run unchanged over the in-process device, a serial port, or QEMU's chardev
+//! on a TCP or Unix socket.
+//!
+//! | transport | type | constructor |
+//! |---|---|---|
+//! | fabric model + soft-core driver inside the host | [`InProcessLink`] | [`InProcessLink::new`] |
+//! | serial port (UART of a real board) | [`SerialLink`] | [`StreamLink::serial`] |
+//! | TCP (QEMU `-chardev socket,host=..,port=..`) | [`TcpLink`] | [`StreamLink::tcp`] |
+//! | Unix socket (QEMU `-chardev socket,path=..`) | [`UnixLink`] | [`StreamLink::unix`] |
+//! | a byte capture played back | [`ReplayLink`] | [`ReplayLink::new`], [`ReplayLink::from_file`] |
+
+mod error;
+mod replay;
+mod serial;
+mod stream;
+mod tcp;
+#[cfg(unix)]
+mod unix;
+
+use std::time::Instant;
+
+pub use error::LinkError;
+pub use replay::ReplayLink;
+pub use serial::SerialLink;
+pub use tcp::TcpLink;
+#[cfg(unix)]
+pub use unix::UnixLink;
+pub use stream::{StreamLink, TimedStream};
+
+/// A bidirectional byte pipe to the device.
+///
+/// Object-safe: the driver is generic over `L: Link`, and `Box<dyn Link>` is a `Link`, so a
+/// transport chosen at run time costs one virtual call per receive.
+pub trait Link: Send {
+    /// Sends all of `bytes` to the device.
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError>;
+
+    /// Waits until at least one byte is available or `deadline` passes; copies up to
+    /// `buf.len()` bytes into `buf` and returns how many (never 0).
+    ///
+    /// Passing the deadline is [`LinkError::Timeout`]; a peer that closed the link is
+    /// [`LinkError::Closed`].
+    fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError>;
+}
+
+impl<L: Link + ?Sized> Link for Box<L> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        (**self).send(bytes)
+    }
+
+    fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
+        (**self).recv(buf, deadline)
+    }
+}
+
+impl<L: Link + ?Sized> Link for &mut L {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        (**self).send(bytes)
+    }
+
+    fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
+        (**self).recv(buf, deadline)
+    }
+}

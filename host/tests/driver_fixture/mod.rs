@@ -1,0 +1,241 @@
+//! Hand-built wire traffic for the driver and link tests: packets encoded with the wire
+//! crate, numbered like the soft-core numbers them, with a record of where each one sits so
+//! a test can drop, cut or corrupt exactly one.
+#![allow(dead_code)] // each test binary uses part of the fixture
+
+use std::ops::Range;
+
+use stereocal_firmware::fabric::geometry::octave_dims;
+use stereocal_wire::{
+    encode, Camera, FrameEndFlags, FrameEndRepr, FrameStartRepr, LogRepr, PacketRepr, Point,
+    PointBatchRepr, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, MAX_FRAME_LEN,
+    MAX_POINTS, PATCH_PIXELS,
+};
+
+/// The Sobel pixel the fixture sends at octave pixel `(x, y)` of `octave`.
+pub fn pattern(octave: u8, x: i32, y: i32) -> SobelPixel {
+    SobelPixel {
+        magnitude: (x * 7 + y * 13 + i32::from(octave) * 29).rem_euclid(256) as u8,
+        orientation: (x + 3 * y + i32::from(octave)).rem_euclid(64) as u8,
+    }
+}
+
+/// How a frame's gradients are sent.
+#[derive(Clone, Debug)]
+pub enum Sobel {
+    None,
+    /// Every row of every octave.
+    Rows,
+    /// A patch for each listed point index, all before the points.
+    Patches(Vec<u16>),
+}
+
+/// One camera frame to send.
+#[derive(Clone, Debug)]
+pub struct FrameSpec {
+    pub frame_id: u32,
+    pub camera: Camera,
+    pub width: u16,
+    pub height: u16,
+    pub octaves: u8,
+    pub timestamp_us: u64,
+    pub points: Vec<Point>,
+    pub sobel: Sobel,
+}
+
+impl FrameSpec {
+    /// A 32x16 frame with 2 octaves and two points.
+    pub fn small(frame_id: u32, camera: Camera) -> Self {
+        Self {
+            frame_id,
+            camera,
+            width: 32,
+            height: 16,
+            octaves: 2,
+            timestamp_us: 1000 * u64::from(frame_id),
+            points: vec![point(5, 6, 0, 4096, -2048), point(3, 4, 1, -4096, 2048)],
+            sobel: Sobel::Rows,
+        }
+    }
+}
+
+pub fn point(x: u16, y: u16, octave: u8, dx: i16, dy: i16) -> Point {
+    Point {
+        x,
+        y,
+        octave,
+        scale: 1,
+        dx,
+        dy,
+        ds: 0,
+        dog: 512,
+    }
+}
+
+/// Wire bytes and where each packet sits in them.
+#[derive(Default)]
+pub struct Wire {
+    pub bytes: Vec<u8>,
+    pub packets: Vec<Range<usize>>,
+    seq: u16,
+}
+
+impl Wire {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sequence number the next packet gets.
+    pub fn next_seq(&self) -> u16 {
+        self.seq
+    }
+
+    /// Encodes `packet` with the next sequence number.
+    pub fn push(&mut self, packet: &PacketRepr<'_>) -> Range<usize> {
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let frame = encode(self.seq, packet, &mut buf).expect("fixture packets encode");
+        self.seq = self.seq.wrapping_add(1);
+        let start = self.bytes.len();
+        self.bytes.extend_from_slice(frame);
+        let range = start..self.bytes.len();
+        self.packets.push(range.clone());
+        range
+    }
+
+    /// A packet the device numbered but the link lost.
+    pub fn lose(&mut self, packet: &PacketRepr<'_>) {
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        encode(self.seq, packet, &mut buf).expect("fixture packets encode");
+        self.seq = self.seq.wrapping_add(1);
+    }
+
+    /// Bytes that are no packet.
+    pub fn raw(&mut self, bytes: &[u8]) {
+        self.bytes.extend_from_slice(bytes);
+    }
+
+    pub fn log(&mut self, bytes: &[u8]) -> Range<usize> {
+        self.push(&PacketRepr::Log(LogRepr { frame: bytes }))
+    }
+
+    /// All packets of a frame; returns the byte range of the whole frame. `lose` names
+    /// packet indices (0 = FrameStart) the link loses.
+    pub fn frame_losing(&mut self, spec: &FrameSpec, lose: &[usize]) -> Range<usize> {
+        let start = self.bytes.len();
+        let packets = frame_packets(spec);
+        for (i, p) in packets.iter().enumerate() {
+            let repr = p.repr();
+            if lose.contains(&i) {
+                self.lose(&repr);
+            } else {
+                self.push(&repr);
+            }
+        }
+        start..self.bytes.len()
+    }
+
+    pub fn frame(&mut self, spec: &FrameSpec) -> Range<usize> {
+        self.frame_losing(spec, &[])
+    }
+}
+
+/// An owned packet of a frame (the wire reprs borrow their records).
+pub enum Owned {
+    Start(FrameStartRepr),
+    Points(u32, Camera, Vec<Point>),
+    Row(u32, Camera, u8, u16, Vec<SobelPixel>),
+    Patch(u32, Camera, u16, Point, Vec<SobelPixel>),
+    End(FrameEndRepr),
+}
+
+impl Owned {
+    pub fn repr(&self) -> PacketRepr<'_> {
+        match self {
+            Owned::Start(s) => PacketRepr::FrameStart(*s),
+            Owned::Points(id, camera, points) => PacketRepr::PointBatch(PointBatchRepr {
+                frame_id: *id,
+                camera: *camera,
+                points: Records::Values(points),
+            }),
+            Owned::Row(id, camera, octave, row, pixels) => PacketRepr::SobelRows(SobelRowsRepr {
+                frame_id: *id,
+                camera: *camera,
+                octave: *octave,
+                scale: 1,
+                row: *row,
+                pixels: Records::Values(pixels),
+            }),
+            Owned::Patch(id, camera, index, p, pixels) => PacketRepr::SobelPatch(SobelPatchRepr {
+                frame_id: *id,
+                camera: *camera,
+                point_index: *index,
+                octave: p.octave,
+                scale: p.scale,
+                x: p.x,
+                y: p.y,
+                pixels: Records::Values(pixels),
+            }),
+            Owned::End(e) => PacketRepr::FrameEnd(*e),
+        }
+    }
+}
+
+/// The packets the soft-core would send for `spec`, in order.
+pub fn frame_packets(spec: &FrameSpec) -> Vec<Owned> {
+    let (id, cam) = (spec.frame_id, spec.camera);
+    let mut out = vec![Owned::Start(FrameStartRepr {
+        frame_id: id,
+        camera: cam,
+        width: spec.width,
+        height: spec.height,
+        octaves: spec.octaves,
+        timestamp_us: spec.timestamp_us,
+    })];
+    let mut sobel_count = 0;
+    match &spec.sobel {
+        Sobel::None => {}
+        Sobel::Rows => {
+            for octave in 0..spec.octaves {
+                let (w, h) = octave_dims(spec.width, spec.height, octave);
+                for y in 0..h {
+                    let row = (0..w)
+                        .map(|x| pattern(octave, i32::from(x), i32::from(y)))
+                        .collect();
+                    out.push(Owned::Row(id, cam, octave, y, row));
+                    sobel_count += 1;
+                }
+            }
+        }
+        Sobel::Patches(indices) => {
+            for &i in indices {
+                let p = spec.points[usize::from(i)];
+                let (w, h) = octave_dims(spec.width, spec.height, p.octave);
+                let pixels = (0..PATCH_PIXELS as i32)
+                    .map(|k| {
+                        let (x, y) = (i32::from(p.x) - 8 + k % 16, i32::from(p.y) - 8 + k / 16);
+                        if x < 0 || y < 0 || x >= i32::from(w) || y >= i32::from(h) {
+                            SobelPixel::default()
+                        } else {
+                            pattern(p.octave, x, y)
+                        }
+                    })
+                    .collect();
+                out.push(Owned::Patch(id, cam, i, p, pixels));
+                sobel_count += 1;
+            }
+        }
+    }
+    for chunk in spec.points.chunks(MAX_POINTS) {
+        out.push(Owned::Points(id, cam, chunk.to_vec()));
+    }
+    out.push(Owned::End(FrameEndRepr {
+        frame_id: id,
+        camera: cam,
+        point_count: spec.points.len() as u32,
+        sobel_count,
+        flags: FrameEndFlags(0),
+        dropped_points: 0,
+        dropped_sobel: 0,
+    }));
+    out
+}

@@ -1,0 +1,361 @@
+//! Frame reassembly and damage handling of the host driver, on hand-built packet sequences
+//! played back through a [`ReplayLink`].
+
+mod driver_fixture;
+
+use std::time::Duration;
+
+use driver_fixture::{frame_packets, pattern, point, FrameSpec, Sobel, Wire};
+use stereocal::driver::{ContentError, Damage, Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame};
+use stereocal::frame::Gradients;
+use stereocal::link::{LinkError, ReplayLink};
+use stereocal_wire::{Camera, PacketKind};
+
+const T: Duration = Duration::from_secs(1);
+
+fn driver(wire: &Wire) -> Driver<ReplayLink> {
+    Driver::new(ReplayLink::new(wire.bytes.clone()))
+}
+
+fn delivered(outcome: FrameOutcome) -> ReceivedFrame {
+    match outcome {
+        FrameOutcome::Delivered(f) => *f,
+        FrameOutcome::Damaged(d) => panic!("frame {} {:?} damaged: {}", d.frame_id, d.camera, d.damage),
+    }
+}
+
+fn damage(outcome: FrameOutcome) -> Damage {
+    match outcome {
+        FrameOutcome::Damaged(d) => d.damage,
+        FrameOutcome::Delivered(f) => panic!("frame {} {:?} delivered", f.frame_id, f.camera),
+    }
+}
+
+/// After the last packet the replay link closes: the driver must say so, not hang.
+fn assert_exhausted(d: &mut Driver<ReplayLink>) {
+    assert!(matches!(
+        d.next_frame(T),
+        Err(DriverError::Link(LinkError::Closed { .. }))
+    ));
+}
+
+#[test]
+fn rows_frame_is_reassembled_with_full_resolution_keypoints() {
+    let mut wire = Wire::new();
+    let spec = FrameSpec::small(7, Camera::Left);
+    let range = wire.frame(&spec);
+    let mut d = driver(&wire);
+    let f = delivered(d.next_frame(T).unwrap());
+    assert_eq!((f.frame_id, f.camera, f.octaves), (7, Camera::Left, 2));
+    assert_eq!(f.wire_bytes, range.len() as u64);
+    assert_eq!(f.packets as usize, frame_packets(&spec).len());
+    let k = f.features.keypoints();
+    assert_eq!(k.len(), 2);
+    // Octave 0: (5 + 0.5, 6 - 0.25). Octave 1: ((3 - 0.5) * 2, (4 + 0.25) * 2).
+    assert_eq!((k[0].x, k[0].y, k[0].octave), (5.5, 5.75, 0));
+    assert_eq!((k[1].x, k[1].y, k[1].octave), (5.0, 8.5, 1));
+    assert_eq!(k[0].dog, 2.0);
+    assert_eq!((f.features.width, f.features.height), (32, 16));
+    assert_eq!(f.features.timestamp_us, 7000);
+    for octave in 0..2u8 {
+        let plane = f.features.plane(octave).expect("plane of every octave");
+        let (w, h) = (32 >> octave, 16 >> octave);
+        assert_eq!((plane.width(), plane.height()), (w, h));
+        for y in 0..h as i32 {
+            for x in 0..w as i32 {
+                let px = pattern(octave, x, y);
+                assert_eq!(plane.get(x, y), Some((px.magnitude, px.orientation)));
+            }
+        }
+    }
+    assert_eq!(d.stats().frames_delivered, 1);
+    assert_eq!(d.stats().delivered_wire_bytes, range.len() as u64);
+    assert_eq!(d.stats().bytes_received, wire.bytes.len() as u64);
+    assert_exhausted(&mut d);
+}
+
+#[test]
+fn any_chunking_of_the_link_gives_the_same_frames() {
+    let mut wire = Wire::new();
+    wire.frame(&FrameSpec::small(1, Camera::Left));
+    wire.log(&[1, 0, 42, 0]);
+    wire.frame(&FrameSpec::small(1, Camera::Right));
+    let reference: Vec<FrameOutcome> = {
+        let mut d = driver(&wire);
+        vec![d.next_frame(T).unwrap(), d.next_frame(T).unwrap()]
+    };
+    for chunk in [1, 2, 3, 7, 64, 1000] {
+        let mut d = Driver::new(ReplayLink::new(wire.bytes.clone()).with_chunk(chunk));
+        let got = vec![d.next_frame(T).unwrap(), d.next_frame(T).unwrap()];
+        assert_eq!(got, reference, "chunk {chunk}");
+        assert_eq!(d.stats().frames_delivered, 2);
+    }
+}
+
+#[test]
+fn patches_are_matched_to_points_and_points_without_patch_are_dropped() {
+    let mut wire = Wire::new();
+    let mut spec = FrameSpec::small(3, Camera::Right);
+    spec.points.push(point(2, 2, 0, 0, 0));
+    // Patch of point 0 near nothing, point 2 at the image corner (zeros outside), none
+    // for point 1.
+    spec.sobel = Sobel::Patches(vec![2, 0]);
+    wire.frame(&spec);
+    let mut d = driver(&wire);
+    let f = delivered(d.next_frame(T).unwrap());
+    assert_eq!(f.points_without_patch, 1);
+    let k = f.features.keypoints();
+    assert_eq!(k.len(), 2);
+    assert_eq!((k[0].x, k[0].y), (5.5, 5.75));
+    assert_eq!((k[1].x, k[1].y), (2.0, 2.0));
+    let Gradients::Patches(patches) = f.features.gradients() else {
+        panic!("patches expected");
+    };
+    assert_eq!(patches.len(), 2);
+    // Window offset (dx, dy) of keypoint 1 is octave pixel (2 + dx, 2 + dy).
+    let px = pattern(0, 3, 1);
+    assert_eq!(f.features.window_sample(1, 1, -1), Some((px.magnitude, px.orientation)));
+    assert_eq!(f.features.window_sample(1, -3, 0), Some((0, 0)));
+    let px = pattern(0, 5, 6);
+    assert_eq!(f.features.window_sample(0, 0, 0), Some((px.magnitude, px.orientation)));
+}
+
+#[test]
+fn sequence_gap_drops_the_frame_and_the_next_one_is_delivered() {
+    let mut wire = Wire::new();
+    let spec = FrameSpec::small(1, Camera::Left);
+    // Lose the third packet (a Sobel row).
+    let lost_seq = wire.next_seq() + 2;
+    wire.frame_losing(&spec, &[2]);
+    wire.frame(&FrameSpec::small(1, Camera::Right));
+    let mut d = driver(&wire);
+    let first = d.next_frame(T).unwrap();
+    assert_eq!((first.frame_id(), first.camera()), (1, Camera::Left));
+    assert_eq!(
+        damage(first),
+        Damage::SequenceGap {
+            expected: lost_seq,
+            got: lost_seq + 1,
+            kind: PacketKind::SobelRows
+        }
+    );
+    let second = delivered(d.next_frame(T).unwrap());
+    assert_eq!(second.camera, Camera::Right);
+    let s = d.stats();
+    assert_eq!((s.frames_delivered, s.frames_damaged), (1, 1));
+    assert_eq!((s.sequence_gaps, s.packets_lost), (1, 1));
+    assert_eq!(s.damage.sequence_gap, 1);
+}
+
+#[test]
+fn lost_frame_start_is_reported_as_missing_start() {
+    let mut wire = Wire::new();
+    wire.frame_losing(&FrameSpec::small(4, Camera::Left), &[0]);
+    wire.frame(&FrameSpec::small(4, Camera::Right));
+    let mut d = driver(&wire);
+    let first = d.next_frame(T).unwrap();
+    assert_eq!(first.frame_id(), 4);
+    assert!(matches!(damage(first), Damage::MissingStart { first } if first.seq == 1));
+    delivered(d.next_frame(T).unwrap());
+}
+
+#[test]
+fn garbage_between_frames_is_skipped() {
+    let mut wire = Wire::new();
+    wire.frame(&FrameSpec::small(1, Camera::Left));
+    // Line noise with delimiters in it, and an over-long run without one.
+    wire.raw(&[0x13, 0x00, 0xff, 0x42, 0x07, 0x00, 0x00, 0x55]);
+    wire.raw(&vec![0x5a; 5000]);
+    wire.raw(&[0x00]);
+    wire.frame(&FrameSpec::small(1, Camera::Right));
+    let mut d = driver(&wire);
+    match d.next_pair(T).unwrap() {
+        PairOutcome::Pair { left, right } => {
+            delivered(left);
+            delivered(right);
+        }
+        other => panic!("pair expected, got {other:?}"),
+    }
+    let s = d.stats();
+    assert!(s.undecodable >= 2, "{s:?}");
+    assert_eq!(s.over_long, 1);
+    assert_eq!(s.frames_damaged, 0);
+}
+
+#[test]
+fn corruption_inside_a_frame_damages_it() {
+    let mut wire = Wire::new();
+    let range = wire.frame(&FrameSpec::small(1, Camera::Left));
+    wire.frame(&FrameSpec::small(1, Camera::Right));
+    let mut bytes = wire.bytes.clone();
+    // Flip a byte in the middle of the left frame (in some Sobel row's pixels).
+    let at = range.start + range.len() / 2;
+    bytes[at] = if bytes[at] == 0x01 { 0x02 } else { 0x01 };
+    let mut d = Driver::new(ReplayLink::new(bytes));
+    let first = d.next_frame(T).unwrap();
+    assert!(
+        matches!(damage(first), Damage::Undecodable { .. }),
+        "a corrupt packet damages its frame"
+    );
+    delivered(d.next_frame(T).unwrap());
+    assert_eq!(d.stats().frames_damaged, 1);
+}
+
+#[test]
+fn frame_cut_short_by_the_next_frame_start_is_damaged() {
+    let mut wire = Wire::new();
+    let spec = FrameSpec::small(2, Camera::Left);
+    let packets = frame_packets(&spec);
+    // The device stops mid-frame (no FrameEnd) but numbers on without a gap.
+    for p in &packets[..packets.len() - 1] {
+        wire.push(&p.repr());
+    }
+    let next_seq = wire.next_seq();
+    wire.frame(&FrameSpec::small(3, Camera::Left));
+    let mut d = driver(&wire);
+    let first = d.next_frame(T).unwrap();
+    match damage(first) {
+        Damage::Truncated { next } => {
+            assert_eq!((next.kind, next.seq, next.frame_id), (PacketKind::FrameStart, next_seq, 3))
+        }
+        other => panic!("truncation expected, got {other}"),
+    }
+    assert_eq!(delivered(d.next_frame(T).unwrap()).frame_id, 3);
+}
+
+#[test]
+fn bytes_cut_off_mid_packet_damage_the_frame() {
+    let mut wire = Wire::new();
+    let range = wire.frame(&FrameSpec::small(2, Camera::Left));
+    let mut bytes = wire.bytes[..range.end - 10].to_vec();
+    let mut next = Wire::new();
+    next.frame(&FrameSpec::small(3, Camera::Left));
+    bytes.extend_from_slice(&next.bytes);
+    let mut d = Driver::new(ReplayLink::new(bytes));
+    // The cut FrameEnd merges with the next FrameStart into one undecodable link frame.
+    assert!(matches!(damage(d.next_frame(T).unwrap()), Damage::Undecodable { .. }));
+    // The next frame's numbering restarted at 0 (another device run); it is then missing
+    // its start and is dropped too, without the driver getting stuck.
+    let second = d.next_frame(T).unwrap();
+    assert_eq!(second.frame_id(), 3);
+    assert_exhausted(&mut d);
+}
+
+#[test]
+fn log_packets_inside_a_frame_are_surfaced_not_damage() {
+    let mut wire = Wire::new();
+    let spec = FrameSpec::small(5, Camera::Left);
+    let packets = frame_packets(&spec);
+    let mut frame_bytes = 0;
+    for (i, p) in packets.iter().enumerate() {
+        frame_bytes += wire.push(&p.repr()).len();
+        if i == 1 {
+            wire.log(&[0x01, 0x00, 0x2a, 0x00]);
+        }
+    }
+    let mut d = driver(&wire);
+    let f = delivered(d.next_frame(T).unwrap());
+    assert_eq!(f.wire_bytes, frame_bytes as u64, "log bytes are not the frame's");
+    let logs = d.take_logs();
+    assert_eq!(logs.len(), 1);
+    assert_eq!((logs[0].seq, &logs[0].bytes[..]), (2, &[0x01, 0x00, 0x2a, 0x00][..]));
+    assert!(d.take_logs().is_empty());
+    assert_eq!(d.stats().log_frames, 1);
+}
+
+#[test]
+fn counts_that_disagree_with_frame_end_damage_the_frame() {
+    let mut wire = Wire::new();
+    let spec = FrameSpec::small(6, Camera::Left);
+    let mut packets = frame_packets(&spec);
+    if let Some(driver_fixture::Owned::End(end)) = packets.last_mut() {
+        end.point_count = 3;
+    }
+    for p in &packets {
+        wire.push(&p.repr());
+    }
+    let mut d = driver(&wire);
+    assert!(matches!(
+        damage(d.next_frame(T).unwrap()),
+        Damage::CountMismatch {
+            points_announced: 3,
+            points_received: 2,
+            ..
+        }
+    ));
+}
+
+#[test]
+fn points_outside_their_octave_are_named() {
+    let mut wire = Wire::new();
+    let mut spec = FrameSpec::small(8, Camera::Left);
+    spec.points.push(point(16, 2, 1, 0, 0)); // octave 1 is 16 wide
+    wire.frame(&spec);
+    let mut d = driver(&wire);
+    match damage(d.next_frame(T).unwrap()) {
+        Damage::Content { packet, problem } => {
+            assert_eq!((packet.kind, packet.frame_id), (PacketKind::PointBatch, 8));
+            assert_eq!(
+                problem,
+                ContentError::PointOutside {
+                    index: 2,
+                    octave: 1,
+                    x: 16,
+                    y: 2,
+                    width: 16,
+                    height: 8
+                }
+            );
+        }
+        other => panic!("content error expected, got {other}"),
+    }
+}
+
+#[test]
+fn a_packet_of_another_frame_damages_both() {
+    let mut wire = Wire::new();
+    let left = frame_packets(&FrameSpec::small(9, Camera::Left));
+    let right = frame_packets(&FrameSpec::small(9, Camera::Right));
+    // Left's start and a row, then right's body without its start, then a whole frame.
+    wire.push(&left[0].repr());
+    wire.push(&left[1].repr());
+    for p in &right[1..] {
+        wire.push(&p.repr());
+    }
+    wire.frame(&FrameSpec::small(10, Camera::Left));
+    let mut d = driver(&wire);
+    assert!(matches!(damage(d.next_frame(T).unwrap()), Damage::Foreign { packet } if packet.camera == Camera::Right));
+    let second = d.next_frame(T).unwrap();
+    assert_eq!((second.frame_id(), second.camera()), (9, Camera::Right));
+    assert!(matches!(damage(second), Damage::Foreign { .. } | Damage::MissingStart { .. }));
+    assert_eq!(delivered(d.next_frame(T).unwrap()).frame_id, 10);
+    assert_eq!(d.stats().frames_damaged, 2);
+}
+
+#[test]
+fn pairs_keep_a_damaged_partner_and_split_lone_frames() {
+    let mut wire = Wire::new();
+    wire.frame(&FrameSpec::small(1, Camera::Left));
+    wire.frame_losing(&FrameSpec::small(1, Camera::Right), &[3]);
+    // Frame 2's right camera is lost without trace.
+    wire.frame(&FrameSpec::small(2, Camera::Left));
+    wire.frame(&FrameSpec::small(3, Camera::Right));
+    wire.frame(&FrameSpec::small(3, Camera::Left));
+    let mut d = driver(&wire);
+    match d.next_pair(T).unwrap() {
+        PairOutcome::Pair { left, right } => {
+            assert_eq!(left.frame_id(), 1);
+            delivered(left);
+            damage(right);
+        }
+        other => panic!("pair expected, got {other:?}"),
+    }
+    let lone = d.next_pair(T).unwrap();
+    assert!(matches!(&lone, PairOutcome::Single(f) if f.frame_id() == 2));
+    let pair = d.next_pair(T).unwrap();
+    assert_eq!(pair.frame_id(), 3);
+    let bytes = pair.wire_bytes();
+    let (l, r) = pair.delivered().expect("both delivered");
+    assert_eq!((l.camera, r.camera), (Camera::Left, Camera::Right));
+    assert_eq!(bytes, l.wire_bytes + r.wire_bytes);
+}
