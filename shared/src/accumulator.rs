@@ -8,8 +8,10 @@ use crate::Error;
 /// Collects the bytes of one COBS frame in a buffer of `N` bytes and decodes it when its
 /// `0x00` arrives.
 ///
-/// `N` must be at least [`MAX_FRAME_LEN`](crate::MAX_FRAME_LEN)` - 1` to receive every packet
-/// kind; a smaller `N` suits a receiver that only expects short packets. A frame longer than
+/// With `N` = [`MAX_FRAME_LEN`](crate::MAX_FRAME_LEN) (the alias
+/// [`FrameAccumulator`](crate::FrameAccumulator)) every packet kind fits (`MAX_FRAME_LEN - 1`
+/// would do: the delimiter is not stored); a smaller `N` suits a receiver that only expects
+/// short packets, such as the firmware's command input. A frame longer than
 /// `N` is reported once as [`FeedResult::OverFull`] and skipped up to its delimiter, so the
 /// next frame decodes normally. Empty frames (`0x00 0x00`) are ignored: a sender may send a
 /// lone `0x00` to flush a receiver's partial frame.

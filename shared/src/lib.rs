@@ -28,10 +28,10 @@
 //! # Receiving (host)
 //! Feed whatever bytes the link delivers to an [`Accumulator`] and loop on the remaining input:
 //! ```
-//! use stereocal_wire::{Accumulator, FeedResult, MAX_FRAME_LEN};
+//! use stereocal_wire::{FeedResult, FrameAccumulator};
 //!
 //! # let link_bytes = [0u8; 3];
-//! let mut acc = Accumulator::<MAX_FRAME_LEN>::new();
+//! let mut acc = FrameAccumulator::new();
 //! let mut window: &[u8] = &link_bytes;
 //! while !window.is_empty() {
 //!     window = match acc.feed(window) {
@@ -145,9 +145,12 @@ pub const MAX_PAYLOAD_LEN: usize = {
 };
 /// Largest packet (header, payload, CRC) before COBS.
 pub const MAX_PACKET_LEN: usize = HEADER_LEN + MAX_PAYLOAD_LEN + CRC_LEN;
-/// Largest frame on the wire (COBS bytes and delimiter); sizes every transmit buffer, and
-/// `MAX_FRAME_LEN - 1` every [`Accumulator`].
+/// Largest frame on the wire (COBS bytes and delimiter); sizes every transmit buffer and
+/// every [`Accumulator`] that must receive all kinds.
 pub const MAX_FRAME_LEN: usize = max_frame_len(MAX_PAYLOAD_LEN);
+
+/// An accumulator that receives every packet kind.
+pub type FrameAccumulator = Accumulator<MAX_FRAME_LEN>;
 
 // The header's payload length field is a u16.
 const _: () = assert!(MAX_PAYLOAD_LEN <= u16::MAX as usize);

@@ -101,7 +101,7 @@ impl<R: Record + fmt::Debug> fmt::Debug for Records<'_, R> {
 }
 
 #[cfg(feature = "defmt")]
-impl<R: Record + defmt::Format> defmt::Format for Records<'_, R> {
+impl<R: Record> defmt::Format for Records<'_, R> {
     fn format(&self, f: defmt::Formatter) {
         defmt::write!(f, "[{} records]", self.len());
     }
