@@ -73,7 +73,14 @@ fn frames() -> (FeatureFrame, FeatureFrame) {
         });
     }
     let lf = FeatureFrame::new(0, 0, W, H, left, Gradients::Planes(vec![plane(7, 0)]));
-    let rf = FeatureFrame::new(0, 0, W, H, right, Gradients::Planes(vec![plane(7, DISPARITY)]));
+    let rf = FeatureFrame::new(
+        0,
+        0,
+        W,
+        H,
+        right,
+        Gradients::Planes(vec![plane(7, DISPARITY)]),
+    );
     (lf.expect("left frame"), rf.expect("right frame"))
 }
 
@@ -89,7 +96,13 @@ fn bench(c: &mut Criterion) {
     let estimator = VergeEstimator::new(calib, config);
     let dl = describe(&lf, &DescriptorConfig::default());
     let dr = describe(&rf, &DescriptorConfig::default());
-    let matches = match_descriptors(&dl, lf.keypoints(), &dr, rf.keypoints(), &MatchConfig::default());
+    let matches = match_descriptors(
+        &dl,
+        lf.keypoints(),
+        &dr,
+        rf.keypoints(),
+        &MatchConfig::default(),
+    );
     assert!(matches.len() > 300, "{} matches", matches.len());
     let pairs: Vec<([f64; 2], [f64; 2])> = matches
         .iter()
@@ -142,7 +155,13 @@ fn bench(c: &mut Criterion) {
     });
     c.bench_function("match only", |b| {
         b.iter(|| {
-            match_descriptors(black_box(&dl), lf.keypoints(), black_box(&dr), rf.keypoints(), &config.matching)
+            match_descriptors(
+                black_box(&dl),
+                lf.keypoints(),
+                black_box(&dr),
+                rf.keypoints(),
+                &config.matching,
+            )
         })
     });
     c.bench_function("E+RANSAC+refine only", |b| {
@@ -165,9 +184,10 @@ fn bench(c: &mut Criterion) {
                 .count()
         })
     });
-    c.bench_function("full estimate (describe+match+subpixel+RANSAC+refine)", |b| {
-        b.iter(|| estimator.estimate(black_box(&lf), black_box(&rf)).ok())
-    });
+    c.bench_function(
+        "full estimate (describe+match+subpixel+RANSAC+refine)",
+        |b| b.iter(|| estimator.estimate(black_box(&lf), black_box(&rf)).ok()),
+    );
 }
 
 criterion_group!(benches, bench);

@@ -125,8 +125,18 @@ impl CameraIntrinsics {
 
     fn validate(&self, path: &Path, side: Side) -> Result<(), CalibError> {
         let checks: [(&'static str, &'static str, f64, bool); 8] = [
-            (side.key("fx"), "must be a finite value > 0", self.fx, self.fx > 0.0),
-            (side.key("fy"), "must be a finite value > 0", self.fy, self.fy > 0.0),
+            (
+                side.key("fx"),
+                "must be a finite value > 0",
+                self.fx,
+                self.fx > 0.0,
+            ),
+            (
+                side.key("fy"),
+                "must be a finite value > 0",
+                self.fy,
+                self.fy > 0.0,
+            ),
             (side.key("cx"), "must be finite", self.cx, true),
             (side.key("cy"), "must be finite", self.cy, true),
             (side.key("k1"), "must be finite", self.k1, true),
@@ -265,10 +275,14 @@ mod tests {
     #[test]
     fn wrong_type_and_missing_key_are_named() {
         let text = GOOD.replace("fx = 500.0", "fx = \"big\"");
-        let msg = Calibration::from_toml_str(&text, "t.toml").unwrap_err().to_string();
+        let msg = Calibration::from_toml_str(&text, "t.toml")
+            .unwrap_err()
+            .to_string();
         assert!(msg.contains("fx") || msg.contains("string"), "{msg}");
         let text = GOOD.replace("baseline_m = 0.3\n", "");
-        let msg = Calibration::from_toml_str(&text, "t.toml").unwrap_err().to_string();
+        let msg = Calibration::from_toml_str(&text, "t.toml")
+            .unwrap_err()
+            .to_string();
         assert!(msg.contains("baseline_m"), "{msg}");
     }
 
@@ -294,7 +308,10 @@ mod tests {
         for &(x, y) in &[(0.0, 0.0), (0.5, -0.4), (-0.7, 0.45), (0.2, 0.1)] {
             let (u, v) = cam.project(x, y);
             let (xb, yb) = cam.normalize(u, v);
-            assert!((xb - x).abs() < 1e-8 && (yb - y).abs() < 1e-8, "{x},{y} -> {xb},{yb}");
+            assert!(
+                (xb - x).abs() < 1e-8 && (yb - y).abs() < 1e-8,
+                "{x},{y} -> {xb},{yb}"
+            );
         }
     }
 }

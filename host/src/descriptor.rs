@@ -25,7 +25,7 @@ pub enum DescriptorMode {
 }
 
 impl DescriptorMode {
-    pub const fn len(self) -> usize {
+    pub const fn dim(self) -> usize {
         match self {
             DescriptorMode::Full128 => 128,
             DescriptorMode::Reduced16 => 16,
@@ -105,7 +105,7 @@ const MIN_COVERAGE: usize = PATCH_SIZE * PATCH_SIZE * 3 / 4;
 /// Computes the descriptor of every keypoint whose gradient window is available (keypoints
 /// whose window leaves the image are skipped; their indices are absent from the set).
 pub fn describe(frame: &FeatureFrame, config: &DescriptorConfig) -> DescriptorSet {
-    let dim = config.mode.len();
+    let dim = config.mode.dim();
     let n = frame.keypoints().len();
     let mut set = DescriptorSet {
         dim,
@@ -119,7 +119,12 @@ pub fn describe(frame: &FeatureFrame, config: &DescriptorConfig) -> DescriptorSe
             continue;
         }
         if config.rotate {
-            accumulate(&window, config.mode, dominant_orientation(&window), &mut hist[..dim]);
+            accumulate(
+                &window,
+                config.mode,
+                dominant_orientation(&window),
+                &mut hist[..dim],
+            );
         } else {
             accumulate_fixed(&window, config.mode, &mut hist[..dim]);
         }
@@ -153,10 +158,11 @@ fn dominant_orientation(window: &[(u8, u8)]) -> f32 {
     }
     let smooth: [f32; 64] =
         std::array::from_fn(|i| 0.25 * h[(i + 63) % 64] + 0.5 * h[i] + 0.25 * h[(i + 1) % 64]);
-    let (best, _) = smooth
-        .iter()
-        .enumerate()
-        .fold((0, f32::MIN), |acc, (i, &v)| if v > acc.1 { (i, v) } else { acc });
+    let (best, _) =
+        smooth.iter().enumerate().fold(
+            (0, f32::MIN),
+            |acc, (i, &v)| if v > acc.1 { (i, v) } else { acc },
+        );
     let (l, c, r) = (
         smooth[(best + 63) % 64],
         smooth[best],
@@ -318,7 +324,11 @@ mod tests {
                 mag.push((h % 200) as u8 + 20);
                 let code = ((h >> 8) % 64) as u8;
                 // Rotating the image by +90° adds 16 codes to every gradient angle.
-                ori.push(if rotate_quarter { (code + 16) % 64 } else { code });
+                ori.push(if rotate_quarter {
+                    (code + 16) % 64
+                } else {
+                    code
+                });
             }
         }
         SobelPlane::new(0, width, height, mag, ori).unwrap()
@@ -386,8 +396,8 @@ mod tests {
         for mode in [DescriptorMode::Full128, DescriptorMode::Reduced16] {
             let mut h1 = [0f32; 128];
             let mut h2 = [0f32; 128];
-            accumulate(&window, mode, 0.0, &mut h1[..mode.len()]);
-            accumulate_fixed(&window, mode, &mut h2[..mode.len()]);
+            accumulate(&window, mode, 0.0, &mut h1[..mode.dim()]);
+            accumulate_fixed(&window, mode, &mut h2[..mode.dim()]);
             for (x, y) in h1.iter().zip(&h2) {
                 assert!((x - y).abs() <= 1e-3 * x.abs().max(1.0), "{x} vs {y}");
             }

@@ -17,6 +17,9 @@ use crate::matching::{match_descriptors, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
 use crate::subpixel::{refine_pair, SubpixelConfig};
 
+/// A matched point pair in full-resolution pixels: (left, right).
+pub type PixelPair = ([f64; 2], [f64; 2]);
+
 /// Which essential-matrix model gives the verge angle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Model {
@@ -112,7 +115,7 @@ impl VergeEstimator {
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
-    ) -> (Vec<Match>, Vec<([f64; 2], [f64; 2])>) {
+    ) -> (Vec<Match>, Vec<PixelPair>) {
         let dl = describe(left, &self.config.descriptor);
         let dr = describe(right, &self.config.descriptor);
         let matches = match_descriptors(
@@ -158,7 +161,7 @@ impl VergeEstimator {
     /// Estimates the verge angle from matched pixel pairs (full resolution, distorted).
     pub fn estimate_from_pixels(
         &self,
-        pairs: &[([f64; 2], [f64; 2])],
+        pairs: &[PixelPair],
     ) -> Result<FrameEstimate, EstimateError> {
         let need = self.config.min_matches;
         if pairs.len() < need {
@@ -254,7 +257,15 @@ mod tests {
             right: cam,
         };
         let truth = VergeAngles::new(1.2f64.to_radians(), -0.7f64.to_radians());
-        let m = synthetic(rot_y(truth.alpha_l), rot_y(truth.alpha_r), 0.11, 600, 0.0, 458.0, 9);
+        let m = synthetic(
+            rot_y(truth.alpha_l),
+            rot_y(truth.alpha_r),
+            0.11,
+            600,
+            0.0,
+            458.0,
+            9,
+        );
         let pairs: Vec<_> = m
             .iter()
             .map(|c| {
@@ -278,7 +289,8 @@ mod tests {
         .unwrap();
         assert!((general.verge_deg - 1.9).abs() < 1e-3, "{general:?}");
         assert!(matches!(
-            VergeEstimator::new(calib, EstimatorConfig::default()).estimate_from_pixels(&pairs[..5]),
+            VergeEstimator::new(calib, EstimatorConfig::default())
+                .estimate_from_pixels(&pairs[..5]),
             Err(EstimateError::TooFewMatches { got: 5, need: 12 })
         ));
     }

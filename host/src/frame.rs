@@ -19,14 +19,18 @@ pub const ORIENTATION_STEPS: u8 = 64;
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum FrameError {
-    #[error("Sobel plane of octave {octave}: {len} magnitude/orientation samples for {width}x{height}")]
+    #[error(
+        "Sobel plane of octave {octave}: {len} magnitude/orientation samples for {width}x{height}"
+    )]
     PlaneSize {
         octave: u8,
         width: u32,
         height: u32,
         len: usize,
     },
-    #[error("Sobel plane of octave {octave}: orientation code {code} at index {index} is not 6-bit")]
+    #[error(
+        "Sobel plane of octave {octave}: orientation code {code} at index {index} is not 6-bit"
+    )]
     OrientationRange { octave: u8, index: usize, code: u8 },
     #[error("{patches} gradient patches for {keypoints} keypoints")]
     PatchCount { patches: usize, keypoints: usize },
@@ -330,7 +334,11 @@ mod tests {
         ));
         assert!(matches!(
             SobelPlane::new(1, 2, 2, vec![0; 4], vec![0, 1, 64, 3]),
-            Err(FrameError::OrientationRange { index: 2, code: 64, .. })
+            Err(FrameError::OrientationRange {
+                index: 2,
+                code: 64,
+                ..
+            })
         ));
         let p = SobelPlane::new(0, 2, 2, vec![1, 2, 3, 4], vec![0, 1, 2, 63]).unwrap();
         assert_eq!(p.get(1, 1), Some((4, 63)));
@@ -344,12 +352,36 @@ mod tests {
             magnitude: [0; 256],
             orientation: [0; 256],
         };
-        let err = FeatureFrame::new(0, 0, 10, 10, vec![kp(1.0, 1.0, 0)], Gradients::Patches(vec![]));
+        let err = FeatureFrame::new(
+            0,
+            0,
+            10,
+            10,
+            vec![kp(1.0, 1.0, 0)],
+            Gradients::Patches(vec![]),
+        );
         assert!(matches!(err, Err(FrameError::PatchCount { .. })));
-        let err = FeatureFrame::new(0, 0, 10, 10, vec![kp(f32::NAN, 1.0, 0)], Gradients::Planes(vec![]));
-        assert!(matches!(err, Err(FrameError::KeypointPosition { index: 0, .. })));
-        let f = FeatureFrame::new(0, 0, 10, 10, vec![kp(3.0, 4.0, 0)], Gradients::Patches(vec![patch]))
-            .unwrap();
+        let err = FeatureFrame::new(
+            0,
+            0,
+            10,
+            10,
+            vec![kp(f32::NAN, 1.0, 0)],
+            Gradients::Planes(vec![]),
+        );
+        assert!(matches!(
+            err,
+            Err(FrameError::KeypointPosition { index: 0, .. })
+        ));
+        let f = FeatureFrame::new(
+            0,
+            0,
+            10,
+            10,
+            vec![kp(3.0, 4.0, 0)],
+            Gradients::Patches(vec![patch]),
+        )
+        .unwrap();
         assert_eq!(f.window_sample(0, -8, -8), Some((0, 0)));
         assert_eq!(f.window_sample(0, 8, 0), None);
     }
@@ -359,8 +391,15 @@ mod tests {
         // Octave 1 plane of a 8x8 image is 4x4; full-res (4, 2) is octave pixel (2, 1).
         let mag: Vec<u8> = (0..16).collect();
         let plane = SobelPlane::new(1, 4, 4, mag, vec![0; 16]).unwrap();
-        let f = FeatureFrame::new(0, 0, 8, 8, vec![kp(4.0, 2.0, 1)], Gradients::Planes(vec![plane]))
-            .unwrap();
+        let f = FeatureFrame::new(
+            0,
+            0,
+            8,
+            8,
+            vec![kp(4.0, 2.0, 1)],
+            Gradients::Planes(vec![plane]),
+        )
+        .unwrap();
         assert_eq!(f.window_sample(0, 0, 0), Some((6, 0)));
         assert_eq!(f.window_sample(0, 1, 1), Some((11, 0)));
         let mut win = [(0u8, 0u8); 256];
@@ -369,7 +408,10 @@ mod tests {
         for dy in -8..8 {
             for dx in -8..8 {
                 let i = ((dy + 8) * 16 + dx + 8) as usize;
-                assert_eq!(Some(win[i]).filter(|_| f.window_sample(0, dx, dy).is_some()), f.window_sample(0, dx, dy));
+                assert_eq!(
+                    Some(win[i]).filter(|_| f.window_sample(0, dx, dy).is_some()),
+                    f.window_sample(0, dx, dy)
+                );
             }
         }
         assert!(f.plane(0).is_none());

@@ -170,7 +170,12 @@ impl VergeFilter {
         let sigma = self.measurement_sigma(m);
         let s = State {
             x: Vector2::new(m.verge_deg, 0.0),
-            p: Matrix2::new(sigma * sigma, 0.0, 0.0, self.config.initial_rate_sigma.powi(2)),
+            p: Matrix2::new(
+                sigma * sigma,
+                0.0,
+                0.0,
+                self.config.initial_rate_sigma.powi(2),
+            ),
             t_us,
         };
         self.state = Some(s);

@@ -94,7 +94,10 @@ pub fn match_descriptors(
     let ys: Vec<f32> = order.iter().map(|&j| ry(j)).collect();
     // The right descriptors copied in y order, so that each band is one contiguous run.
     let dim = right.dim();
-    let sorted: Vec<u8> = order.iter().flat_map(|&j| right.get(j as usize).iter().copied()).collect();
+    let sorted: Vec<u8> = order
+        .iter()
+        .flat_map(|&j| right.get(j as usize).iter().copied())
+        .collect();
     let band = config.max_vertical_px.unwrap_or(f32::INFINITY);
 
     // Best left (distance, index) per right descriptor, for the cross check.
@@ -190,14 +193,23 @@ mod tests {
         let pts: Vec<(f32, f32)> = (0..40)
             .map(|i| (20.0 + (i % 8) as f32 * 25.0, 20.0 + (i / 8) as f32 * 25.0))
             .collect();
-        let right_pts: Vec<(f32, f32)> = pts.iter().rev().map(|&(x, y)| (x - 7.0, y + 1.0)).collect();
+        let right_pts: Vec<(f32, f32)> =
+            pts.iter().rev().map(|&(x, y)| (x - 7.0, y + 1.0)).collect();
         let l = frame(textured(240, 160, 0, 0), &pts);
         let r = frame(textured(240, 160, -7, 1), &right_pts);
         let cfg = DescriptorConfig::default();
         let (dl, dr) = (describe(&l, &cfg), describe(&r, &cfg));
-        let m = match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &MatchConfig::default());
+        let m = match_descriptors(
+            &dl,
+            l.keypoints(),
+            &dr,
+            r.keypoints(),
+            &MatchConfig::default(),
+        );
         assert_eq!(m.len(), 40);
-        assert!(m.iter().all(|m| m.left + m.right == 39 && m.distance == 0.0));
+        assert!(m
+            .iter()
+            .all(|m| m.left + m.right == 39 && m.distance == 0.0));
         let few = MatchConfig {
             best_n: Some(20),
             ..MatchConfig::default()

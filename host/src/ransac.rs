@@ -83,7 +83,7 @@ pub fn minimal_solutions(c0: &Correspondence, c1: &Correspondence) -> heapless_p
     // q = (sin, cos) = cos·(t, 1) with t = tan a_l:  s00 t² + 2 s01 t + s11 = 0.
     let (qa, qb, qc) = (s[(0, 0)], 2.0 * s[(0, 1)], s[(1, 1)]);
     let disc = qb * qb - 4.0 * qa * qc;
-    if !(disc >= 0.0) || qa.abs() < 1e-300 {
+    if disc.is_nan() || disc < 0.0 || qa.abs() < 1e-300 {
         return out;
     }
     let sq = disc.sqrt();
@@ -256,7 +256,10 @@ mod tests {
         let a = ransac(&m, &cfg).unwrap();
         let b = ransac(&m, &cfg).unwrap();
         assert_eq!(a, b);
-        assert!((a.angles.verge() - truth.verge()).to_degrees().abs() < 0.3, "{a:?}");
+        assert!(
+            (a.angles.verge() - truth.verge()).to_degrees().abs() < 0.3,
+            "{a:?}"
+        );
         assert!(a.inliers.iter().step_by(3).all(|&x| !x));
         assert!(a.inlier_count >= 180, "{}", a.inlier_count);
         let other = ransac(&m, &RansacConfig { seed: 99, ..cfg }).unwrap();

@@ -106,7 +106,7 @@ pub fn refine_pair(
         hyy += gy[i] * gy[i];
     }
     let det = hxx * hyy - hxy * hxy;
-    if !(det > 1e-6 * (hxx + hyy).powi(2)) || t_norm <= 0.0 {
+    if det.is_nan() || det <= 1e-6 * (hxx + hyy).powi(2) || t_norm <= 0.0 {
         return None;
     }
     // Start: the right point shifted by the same amount the left one was snapped.
@@ -126,7 +126,11 @@ pub fn refine_pair(
             }
         }
         let mean = warped.iter().sum::<f32>() / n as f32;
-        let norm = warped.iter().map(|v| (v - mean).powi(2)).sum::<f32>().sqrt();
+        let norm = warped
+            .iter()
+            .map(|v| (v - mean).powi(2))
+            .sum::<f32>()
+            .sqrt();
         if norm <= 0.0 {
             return None;
         }
@@ -164,7 +168,11 @@ pub fn refine_pair(
         }
     }
     let mean = warped.iter().sum::<f32>() / n as f32;
-    let norm = warped.iter().map(|v| (v - mean).powi(2)).sum::<f32>().sqrt();
+    let norm = warped
+        .iter()
+        .map(|v| (v - mean).powi(2))
+        .sum::<f32>()
+        .sqrt();
     if norm <= 0.0 {
         return None;
     }
@@ -233,10 +241,17 @@ mod tests {
     #[test]
     fn rejects_featureless_and_border_windows() {
         let flat = SobelPlane::new(0, 40, 40, vec![50; 1600], vec![0; 1600]).unwrap();
-        assert!(refine_pair(&flat, &flat, [20.0, 20.0], [20.0, 20.0], &SubpixelConfig::default())
-            .is_none());
+        assert!(refine_pair(
+            &flat,
+            &flat,
+            [20.0, 20.0],
+            [20.0, 20.0],
+            &SubpixelConfig::default()
+        )
+        .is_none());
         let l = plane(40, 40, 0.0, 0.0, 1.0);
-        assert!(refine_pair(&l, &l, [3.0, 20.0], [3.0, 20.0], &SubpixelConfig::default())
-            .is_none());
+        assert!(
+            refine_pair(&l, &l, [3.0, 20.0], [3.0, 20.0], &SubpixelConfig::default()).is_none()
+        );
     }
 }

@@ -26,14 +26,25 @@ use stereocal_firmware::fabric::{run_frame, Config, FastFrontEnd};
 fn data_root() -> Option<PathBuf> {
     let root = std::env::var_os("STEREOCAL_REAL_DATA")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/real")));
+        .unwrap_or_else(|| {
+            PathBuf::from(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../shared/data/real"
+            ))
+        });
     if root.join("eth3d_two_view").is_dir() {
         return Some(root);
     }
     if std::env::var("CI").as_deref() == Ok("true") {
-        panic!("real data missing at {} (required under CI=true)", root.display());
+        panic!(
+            "real data missing at {} (required under CI=true)",
+            root.display()
+        );
     }
-    eprintln!("SKIPPED: real data not found at {} — set STEREOCAL_REAL_DATA", root.display());
+    eprintln!(
+        "SKIPPED: real data not found at {} — set STEREOCAL_REAL_DATA",
+        root.display()
+    );
     None
 }
 
@@ -44,7 +55,10 @@ fn grey(path: &std::path::Path) -> GrayImage {
 }
 
 fn camera(v: &serde_json::Value) -> CameraIntrinsics {
-    let f = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("geometry.json: missing {k}"));
+    let f = |k: &str| {
+        v[k].as_f64()
+            .unwrap_or_else(|| panic!("geometry.json: missing {k}"))
+    };
     let d = |i: usize| v["dist"][i].as_f64().unwrap_or(0.0);
     CameraIntrinsics {
         k1: d(0),
@@ -63,11 +77,19 @@ fn features(img: &GrayImage, index: u64, keep: &dyn Fn(f32, f32) -> bool) -> Fea
     let mut fe = Box::new(FastFrontEnd::<1280, 640, 320, 160>::new());
     let mut points = Vec::new();
     let mut sobel = Vec::new();
-    let overflow = run_frame(&mut *fe, &config, img.as_raw(), &mut |p| points.push(p), &mut |s| {
-        sobel.push(s)
-    })
+    let overflow = run_frame(
+        &mut *fe,
+        &config,
+        img.as_raw(),
+        &mut |p| points.push(p),
+        &mut |s| sobel.push(s),
+    )
     .expect("fabric fast path");
-    assert_eq!(overflow.points + overflow.sobel, 0, "fabric FIFO overflow {overflow:?}");
+    assert_eq!(
+        overflow.points + overflow.sobel,
+        0,
+        "fabric FIFO overflow {overflow:?}"
+    );
     let mut planes: Vec<SobelPlane> = Vec::new();
     for octave in 0..config.octaves {
         let (pw, ph) = (w.div_ceil(1 << octave), h.div_ceil(1 << octave));
@@ -94,9 +116,23 @@ fn features(img: &GrayImage, index: u64, keep: &dyn Fn(f32, f32) -> bool) -> Fea
                 dog: p.dog as f32 / 256.0,
             }
         })
-        .filter(|k| keep(k.x, k.y) && k.x >= 0.0 && k.y >= 0.0 && k.x <= (w - 1) as f32 && k.y <= (h - 1) as f32)
+        .filter(|k| {
+            keep(k.x, k.y)
+                && k.x >= 0.0
+                && k.y >= 0.0
+                && k.x <= (w - 1) as f32
+                && k.y <= (h - 1) as f32
+        })
         .collect();
-    FeatureFrame::new(index, index * 33_333, w, h, keypoints, Gradients::Planes(planes)).expect("frame")
+    FeatureFrame::new(
+        index,
+        index * 33_333,
+        w,
+        h,
+        keypoints,
+        Gradients::Planes(planes),
+    )
+    .expect("frame")
 }
 
 struct Scene {
@@ -108,9 +144,10 @@ struct Scene {
 
 fn eth3d_scenes(root: &std::path::Path) -> Vec<Scene> {
     let dir = root.join("eth3d_two_view");
-    let geo: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("geometry.json")).expect("geometry.json"))
-            .expect("geometry.json is JSON");
+    let geo: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("geometry.json")).expect("geometry.json"),
+    )
+    .expect("geometry.json is JSON");
     ["terrace", "playground"]
         .into_iter()
         .map(|name| {
@@ -145,8 +182,16 @@ fn run_frame_pair(
     let wr = YawWarp::new(&scene.calib.right, alpha_r);
     let (il, ir) = rayon::join(|| wl.apply(&scene.left), || wr.apply(&scene.right));
     let (fl, fr) = rayon::join(
-        || features(&il, index, &|x, y| wl.source_inside(x as f64, y as f64, w, h, BORDER_MARGIN)),
-        || features(&ir, index, &|x, y| wr.source_inside(x as f64, y as f64, w, h, BORDER_MARGIN)),
+        || {
+            features(&il, index, &|x, y| {
+                wl.source_inside(x as f64, y as f64, w, h, BORDER_MARGIN)
+            })
+        },
+        || {
+            features(&ir, index, &|x, y| {
+                wr.source_inside(x as f64, y as f64, w, h, BORDER_MARGIN)
+            })
+        },
     );
     est.estimate(&fl, &fr).ok()
 }
@@ -167,10 +212,18 @@ fn stats(errors: &[Option<f64>], matches: &[usize]) -> Stats {
     let frames = errors.len();
     let estimated = e.len();
     e.sort_by(f64::total_cmp);
-    let residual = if e.is_empty() { f64::NAN } else { e[e.len() / 2] };
+    let residual = if e.is_empty() {
+        f64::NAN
+    } else {
+        e[e.len() / 2]
+    };
     let mut abs: Vec<f64> = e.iter().map(|v| (v - residual).abs()).collect();
     abs.sort_by(f64::total_cmp);
-    let pick = |q: f64| abs.get(((abs.len() as f64 - 1.0) * q).round() as usize).copied().unwrap_or(f64::NAN);
+    let pick = |q: f64| {
+        abs.get(((abs.len() as f64 - 1.0) * q).round() as usize)
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
     Stats {
         frames,
         estimated,
@@ -206,7 +259,10 @@ fn injected_verge_on_street_pairs() {
             .iter()
             .map(|(truth, e)| e.as_ref().map(|e| e.verge_deg - truth.to_degrees()))
             .collect();
-        let matches: Vec<usize> = results.iter().filter_map(|(_, e)| e.as_ref().map(|e| e.used)).collect();
+        let matches: Vec<usize> = results
+            .iter()
+            .filter_map(|(_, e)| e.as_ref().map(|e| e.used))
+            .collect();
         let s = stats(&errors, &matches);
         println!(
             "{:<10} moving: {}/{} estimated, residual {:+.4}°, |err| median {:.4}° p95 {:.4}° max {:.4}°, {:.0} matches/frame",
@@ -233,20 +289,36 @@ fn injected_verge_on_street_pairs() {
             .into_par_iter()
             .map(|i| {
                 let common = 1.0 * (i as f64 / FRAMES as f64 * std::f64::consts::TAU).sin();
-                run_frame_pair(&scene, &est, i as u64, (common + 0.75).to_radians(), (common - 0.75).to_radians())
+                run_frame_pair(
+                    &scene,
+                    &est,
+                    i as u64,
+                    (common + 0.75).to_radians(),
+                    (common - 0.75).to_radians(),
+                )
             })
             .collect();
         let mut filter = VergeFilter::new(KalmanConfig::default());
         let mut filtered = Vec::new();
         for (i, e) in fixed.iter().enumerate() {
-            let m = e.as_ref().map(|e| Measurement { verge_deg: e.verge_deg, sigma_deg: e.sigma_deg });
-            if let Some(o) = filter.step(i as u64 * 33_333, m).expect("time runs forward") {
+            let m = e.as_ref().map(|e| Measurement {
+                verge_deg: e.verge_deg,
+                sigma_deg: e.sigma_deg,
+            });
+            if let Some(o) = filter
+                .step(i as u64 * 33_333, m)
+                .expect("time runs forward")
+            {
                 filtered.push(o.verge_deg);
             }
         }
         let settled = &filtered[filtered.len().min(8)..];
-        let span = settled.iter().cloned().fold(f64::MIN, f64::max) - settled.iter().cloned().fold(f64::MAX, f64::min);
-        let raw: Vec<Option<f64>> = fixed.iter().map(|e| e.as_ref().map(|e| e.verge_deg - 1.5)).collect();
+        let span = settled.iter().cloned().fold(f64::MIN, f64::max)
+            - settled.iter().cloned().fold(f64::MAX, f64::min);
+        let raw: Vec<Option<f64>> = fixed
+            .iter()
+            .map(|e| e.as_ref().map(|e| e.verge_deg - 1.5))
+            .collect();
         let fs = stats(&raw, &[]);
         println!(
             "{:<10} fixed 1.5°: {}/{} estimated, raw |err| median {:.4}° max {:.4}°, filtered span {:.4}° (after 8 frames)",
@@ -263,11 +335,22 @@ fn injected_verge_on_street_pairs() {
         total.p95,
         total.max
     );
-    assert!(fraction >= 0.95, "only {:.1}% of frames estimated", 100.0 * fraction);
-    assert!(total.median <= MEDIAN_LIMIT_DEG, "median {:.4}°", total.median);
+    assert!(
+        fraction >= 0.95,
+        "only {:.1}% of frames estimated",
+        100.0 * fraction
+    );
+    assert!(
+        total.median <= MEDIAN_LIMIT_DEG,
+        "median {:.4}°",
+        total.median
+    );
     assert!(total.max <= MAX_LIMIT_DEG, "max {:.4}°", total.max);
     for span in fixed_spans {
-        assert!(span <= FIXED_SPAN_LIMIT_DEG, "fixed-camera filtered span {span:.4}°");
+        assert!(
+            span <= FIXED_SPAN_LIMIT_DEG,
+            "fixed-camera filtered span {span:.4}°"
+        );
     }
 }
 
@@ -279,9 +362,10 @@ const FIXED_SPAN_LIMIT_DEG: f64 = 0.03;
 fn euroc_raw_pairs_with_the_general_model() {
     let Some(root) = data_root() else { return };
     let dir = root.join("euroc_pairs");
-    let geo: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("geometry.json")).expect("geometry.json"))
-            .expect("JSON");
+    let geo: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("geometry.json")).expect("geometry.json"),
+    )
+    .expect("JSON");
     let calib = Calibration {
         baseline_m: geo["stereo"]["baseline_m"].as_f64().expect("baseline"),
         left: camera(&geo["cam0"]),
@@ -290,7 +374,13 @@ fn euroc_raw_pairs_with_the_general_model() {
     let ypr = &geo["stereo"]["yaw_pitch_roll_deg"];
     let truth_verge = -ypr[0].as_f64().expect("yaw");
     let truth_pitch = ypr[1].as_f64().expect("pitch");
-    let general = VergeEstimator::new(calib, EstimatorConfig { model: Model::General, ..EstimatorConfig::default() });
+    let general = VergeEstimator::new(
+        calib,
+        EstimatorConfig {
+            model: Model::General,
+            ..EstimatorConfig::default()
+        },
+    );
     let constrained = VergeEstimator::new(calib, EstimatorConfig::default());
     let mut errs = Vec::new();
     for name in ["lcd0", "lcd1", "lcd2", "lcd3", "sf0", "sf1"] {
@@ -316,15 +406,25 @@ fn euroc_raw_pairs_with_the_general_model() {
                     c.as_ref().map(|c| format!("{:+.4}° res {:.3}px", c.verge_deg, c.residual_px)).unwrap_or_else(|e| e.to_string())
                 );
                 errs.push((g.verge_deg - truth_verge).abs());
-                assert!((p.pitch.to_degrees() - truth_pitch).abs() < 0.1, "{name}: pitch {p:?}");
+                assert!(
+                    (p.pitch.to_degrees() - truth_pitch).abs() < 0.1,
+                    "{name}: pitch {p:?}"
+                );
             }
             Err(e) => println!("{name}: no estimate ({e})"),
         }
     }
-    assert!(errs.len() >= 5, "only {} of 6 EuRoC pairs estimated", errs.len());
+    assert!(
+        errs.len() >= 5,
+        "only {} of 6 EuRoC pairs estimated",
+        errs.len()
+    );
     let worst = errs.iter().cloned().fold(0.0, f64::max);
     println!("EuRoC general model: worst |verge error| {worst:.4}°");
-    assert!(worst < EUROC_LIMIT_DEG, "EuRoC worst verge error {worst:.4}°");
+    assert!(
+        worst < EUROC_LIMIT_DEG,
+        "EuRoC worst verge error {worst:.4}°"
+    );
 }
 
 const EUROC_LIMIT_DEG: f64 = 0.1;

@@ -304,10 +304,21 @@ mod tests {
             let num = |dl: f64, dr: f64| {
                 let p = VergeAngles::new(a.alpha_l + dl, a.alpha_r + dr);
                 let q = VergeAngles::new(a.alpha_l - dl, a.alpha_r - dr);
-                (sampson_residual(&p.essential(), c) - sampson_residual(&q.essential(), c)) / (2.0 * h)
+                (sampson_residual(&p.essential(), c) - sampson_residual(&q.essential(), c))
+                    / (2.0 * h)
             };
-            assert!((g[0] - num(h, 0.0)).abs() < 1e-6, "{} vs {}", g[0], num(h, 0.0));
-            assert!((g[1] - num(0.0, h)).abs() < 1e-6, "{} vs {}", g[1], num(0.0, h));
+            assert!(
+                (g[0] - num(h, 0.0)).abs() < 1e-6,
+                "{} vs {}",
+                g[0],
+                num(h, 0.0)
+            );
+            assert!(
+                (g[1] - num(0.0, h)).abs() < 1e-6,
+                "{} vs {}",
+                g[1],
+                num(0.0, h)
+            );
         }
     }
 

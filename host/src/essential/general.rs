@@ -7,7 +7,9 @@
 use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Unit, Vector3};
 
 use super::constrained::VergeAngles;
-use super::{mad_sigma, rot_y, sampson_residual, skew, Correspondence, EssentialError, RefineConfig};
+use super::{
+    mad_sigma, rot_y, sampson_residual, skew, Correspondence, EssentialError, RefineConfig,
+};
 
 /// Relative pose of the right camera with respect to the left one.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -241,8 +243,12 @@ mod tests {
         let m = synthetic(Matrix3::identity(), r01, 0.11, 1000, 0.05, f, 3);
         let init = crate::ransac::ransac(&m, &crate::ransac::RansacConfig::default()).unwrap();
         let cfit = constrained::refine(&m, init.angles, &RefineConfig::default()).unwrap();
-        let gfit = refine(&m, RelativePose::from_verge(cfit.angles), &RefineConfig::default())
-            .unwrap();
+        let gfit = refine(
+            &m,
+            RelativePose::from_verge(cfit.angles),
+            &RefineConfig::default(),
+        )
+        .unwrap();
         let ypr = gfit.pose.yaw_pitch_roll();
         let g_err = (gfit.pose.verge().to_degrees() - 0.5).abs();
         let c_err = (cfit.angles.verge_deg() - 0.5).abs();
