@@ -116,3 +116,38 @@ fn max_frame_len_covers_the_largest_packet() {
     let mut frame = frame.to_vec();
     assert_eq!(decode(&mut frame).unwrap().1, repr);
 }
+
+/// Runs of non-zero bytes around the 254-byte COBS block length, where the in-place encoder
+/// has its only special case (a full block and whether another code byte follows).
+#[test]
+fn long_nonzero_runs_encode_like_the_cobs_crate() {
+    let nonzero = [0xffu8; stereocal_wire::MAX_LOG_LEN];
+    let bright = [stereocal_wire::SobelPixel {
+        magnitude: 0xff,
+        orientation: 0x3f,
+    }; 400];
+    for len in 0..=nonzero.len() {
+        let log = PacketRepr::Log(stereocal_wire::LogRepr {
+            frame: &nonzero[..len],
+        });
+        let rows = PacketRepr::SobelRows(stereocal_wire::SobelRowsRepr {
+            frame_id: 0xffff_ffff,
+            camera: stereocal_wire::Camera::Unknown(0xff),
+            octave: 0xff,
+            scale: 0xff,
+            row: 0xffff,
+            pixels: stereocal_wire::Records::Values(&bright[..len + 100]),
+        });
+        for repr in [log, rows] {
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            let mut frame = encode(0xffff, &repr, &mut buf).unwrap().to_vec();
+            let body = &frame[..frame.len() - 1];
+            let mut raw = vec![0u8; body.len()];
+            let raw_len = cobs::decode(body, &mut raw).unwrap().frame_size();
+            let mut reference = vec![0u8; cobs::max_encoding_length(raw_len)];
+            let reference_len = cobs::encode(&raw[..raw_len], &mut reference);
+            assert_eq!(body, &reference[..reference_len], "{repr:?}");
+            assert_eq!(decode(&mut frame).unwrap().1, repr);
+        }
+    }
+}

@@ -216,7 +216,8 @@ mod tests {
         }
     }
 
-    static PACKET_HEAD: [u8; HEADER_LEN] = [
+    /// The fixed fields; the pixels follow, pixel `i` = (magnitude `i`, orientation `i % 64`).
+    const PACKET_HEAD: [u8; HEADER_LEN] = [
         0x07, 0x00, 0x00, 0x00, // frame_id 7
         0x00, // camera Left
         0x05, 0x00, // point_index 5
@@ -226,15 +227,21 @@ mod tests {
         0x78, 0x00, // y 120
     ];
 
-    fn packet_bytes() -> [u8; LEN] {
+    static PACKET_BYTES: [u8; LEN] = {
         let mut bytes = [0u8; LEN];
-        bytes[..HEADER_LEN].copy_from_slice(&PACKET_HEAD);
-        for i in 0..PATCH_PIXELS {
-            bytes[HEADER_LEN + 2 * i] = i as u8;
-            bytes[HEADER_LEN + 2 * i + 1] = (i % 64) as u8;
+        let mut i = 0;
+        while i < HEADER_LEN {
+            bytes[i] = PACKET_HEAD[i];
+            i += 1;
+        }
+        let mut pixel = 0;
+        while pixel < PATCH_PIXELS {
+            bytes[HEADER_LEN + 2 * pixel] = pixel as u8;
+            bytes[HEADER_LEN + 2 * pixel + 1] = (pixel % 64) as u8;
+            pixel += 1;
         }
         bytes
-    }
+    };
 
     fn pixels() -> [SobelPixel; PATCH_PIXELS] {
         core::array::from_fn(pixel)
@@ -255,7 +262,7 @@ mod tests {
 
     #[test]
     fn deconstruct() {
-        let bytes = packet_bytes();
+        let bytes = PACKET_BYTES;
         let packet = Packet::new_checked(&bytes[..]).unwrap();
         assert_eq!(packet.frame_id(), 7);
         assert_eq!(packet.camera(), Camera::Left);
@@ -281,12 +288,12 @@ mod tests {
         for (i, chunk) in packet.pixels_mut().chunks_exact_mut(2).enumerate() {
             pixel(i).write(chunk);
         }
-        assert_eq!(bytes, packet_bytes());
+        assert_eq!(bytes, PACKET_BYTES);
     }
 
     #[test]
     fn parse() {
-        let bytes = packet_bytes();
+        let bytes = PACKET_BYTES;
         let pixels = pixels();
         let packet = Packet::new_unchecked(&bytes[..]);
         assert_eq!(SobelPatchRepr::parse(&packet), Ok(repr(&pixels)));
@@ -299,12 +306,12 @@ mod tests {
         repr(&pixels)
             .emit(&mut Packet::new_unchecked(&mut bytes[..]))
             .unwrap();
-        assert_eq!(bytes, packet_bytes());
+        assert_eq!(bytes, PACKET_BYTES);
     }
 
     #[test]
     fn orientation_top_bits_are_rejected() {
-        let mut bytes = packet_bytes();
+        let mut bytes = PACKET_BYTES;
         bytes[LEN - 1] |= 0x80;
         let packet = Packet::new_checked(&bytes[..]).unwrap();
         assert_eq!(
@@ -322,7 +329,7 @@ mod tests {
 
     #[test]
     fn impossible_length() {
-        let bytes = packet_bytes();
+        let bytes = PACKET_BYTES;
         assert_eq!(
             Packet::new_checked(&bytes[..LEN - 1]).unwrap_err(),
             Error::DecodeUnexpectedEnd
