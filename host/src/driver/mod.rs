@@ -271,9 +271,7 @@ impl<L: Link> Driver<L> {
             if let Some(frame) = self.frames.pop_front() {
                 return Ok(frame);
             }
-            let waiting = Waiting::Frame {
-                in_progress: self.assembler.in_progress(),
-            };
+            let waiting = Waiting::Frame { in_progress: None };
             self.pump(deadline, timeout, waiting)?;
         }
     }
@@ -327,10 +325,17 @@ impl<L: Link> Driver<L> {
                     self.assembler.stats.bytes_received += self.rx_len as u64;
                 }
                 Err(LinkError::Timeout { .. }) => {
+                    // Bytes decoded while waiting may have opened a frame.
+                    let waiting_for = match waiting {
+                        Waiting::Frame { .. } => Waiting::Frame {
+                            in_progress: self.assembler.in_progress(),
+                        },
+                        other => other,
+                    };
                     return Err(DriverError::Timeout {
-                        waiting_for: waiting,
+                        waiting_for,
                         timeout,
-                    })
+                    });
                 }
                 Err(e) => return Err(DriverError::Link(e)),
             }

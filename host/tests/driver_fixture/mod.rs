@@ -3,6 +3,8 @@
 //! a test can drop, cut or corrupt exactly one.
 #![allow(dead_code)] // each test binary uses part of the fixture
 
+pub mod device;
+
 use std::ops::Range;
 
 use stereocal_firmware::fabric::geometry::octave_dims;
