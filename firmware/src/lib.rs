@@ -5,4 +5,6 @@
 //! code runs on the `riscv32imc` soft-core and on the host.
 #![no_std]
 
+pub mod driver;
 pub mod fabric;
+pub mod softcore;

@@ -1,0 +1,493 @@
+//! The driver of one camera channel: its fabric, its registers, its frame counter.
+
+use stereocal_hdl::regs::output_mode::SobelOutput;
+use stereocal_hdl::{register_at, FabricConfig, RegisterBus};
+use stereocal_wire::{
+    Camera, Capabilities, ErrorCode, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr,
+    HelloRepr, PacketRepr, PointBatchRepr, Records, RegisterValueRepr, SobelPatchRepr, SobelPixel,
+    SobelRowsRepr, PATCH_PIXELS, PATCH_SIZE, PROTOCOL_VERSION,
+};
+
+use crate::driver::error::{DriverError, ERROR_UNEXPECTED_KIND};
+use crate::driver::patch::{PatchQueue, PendingPatch, HALF};
+use crate::driver::point_batch::{wire_point, PointBatch};
+use crate::driver::sink::{ByteSink, PacketWriter};
+use crate::driver::sobel_ring::{Completed, SobelRing};
+use crate::fabric::{Config, Extremum, FrameError, FrontEnd, Overflow, SobelPixel as FabricSobel};
+
+/// What a channel can send, as announced in its `Hello`.
+pub const CHANNEL_CAPABILITIES: Capabilities = Capabilities(
+    Capabilities::POINTS.0
+        | Capabilities::SOBEL_ROWS.0
+        | Capabilities::SOBEL_PATCHES.0
+        | Capabilities::REGISTERS.0,
+);
+
+/// What one frame produced and lost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameSummary {
+    /// The frame's number (as in FrameStart/FrameEnd).
+    pub frame_id: u32,
+    /// Points sent in `PointBatch` packets.
+    pub points: u32,
+    /// `SobelRows` or `SobelPatch` packets sent.
+    pub sobel_packets: u32,
+    /// Records the fabric's FIFOs dropped.
+    pub overflow: Overflow,
+    /// Points that got no patch (their rows had left the ring, or the patch queue was full).
+    pub patches_dropped: u32,
+}
+
+/// Per-frame state.
+#[derive(Clone, Copy, Debug)]
+struct FrameState {
+    id: u32,
+    mode: SobelOutput,
+    sobel_scale: u8,
+    points: u32,
+    sobel_packets: u32,
+    patches_dropped: u32,
+}
+
+/// The fabric configuration the registers describe, in the model's terms.
+///
+/// The contrast register counts whole grey levels; the model compares Q8.8 DoG samples, so the
+/// value moves up 8 bits. The refinement bound is not a register: the model's default is kept.
+pub fn fabric_config(registers: &FabricConfig) -> Config {
+    Config {
+        width: registers.width,
+        height: registers.height,
+        octaves: registers.octaves,
+        contrast_threshold: u16::from(registers.contrast_threshold) << 8,
+        edge_ratio: registers.edge_ratio,
+        sobel_scale: registers.sobel_scale,
+        ..Config::new(registers.width, registers.height)
+    }
+}
+
+/// Drives one camera channel: configures its fabric through `B`, runs frames through `F`, and
+/// sends what comes out of the FIFOs as wire packets.
+///
+/// `W0` is the widest frame the driver's Sobel ring holds (the fabric's octave-0 line length).
+/// The driver is large (the ring holds 32 rows per octave); on the host, box it.
+pub struct Driver<B: RegisterBus, F: FrontEnd, const W0: usize = 1280> {
+    bus: B,
+    fabric: F,
+    camera: Camera,
+    capabilities: Capabilities,
+    next_frame_id: u32,
+    frame: FrameState,
+    ring: SobelRing<W0>,
+    patches: PatchQueue,
+    batch: PointBatch,
+    patch: [SobelPixel; PATCH_PIXELS],
+}
+
+impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
+    /// A driver for `camera`'s fabric, reached through `bus` (its registers) and `fabric` (its
+    /// pixel input and FIFOs). The first frame is number 0.
+    pub fn new(bus: B, fabric: F, camera: Camera) -> Self {
+        Self {
+            bus,
+            fabric,
+            camera,
+            capabilities: CHANNEL_CAPABILITIES,
+            next_frame_id: 0,
+            frame: FrameState {
+                id: 0,
+                mode: SobelOutput::Patches,
+                sobel_scale: 0,
+                points: 0,
+                sobel_packets: 0,
+                patches_dropped: 0,
+            },
+            ring: SobelRing::new(),
+            patches: PatchQueue::new(),
+            batch: PointBatch::new(),
+            patch: [SobelPixel::default(); PATCH_PIXELS],
+        }
+    }
+
+    /// Adds capability bits to the `Hello` answer (the soft-core adds `LOG`).
+    pub fn with_capabilities(mut self, extra: Capabilities) -> Self {
+        self.capabilities = self.capabilities | extra;
+        self
+    }
+
+    /// The camera this channel serves.
+    pub fn camera(&self) -> Camera {
+        self.camera
+    }
+
+    /// The number the next frame will get.
+    pub fn next_frame_id(&self) -> u32 {
+        self.next_frame_id
+    }
+
+    /// The register bus.
+    pub fn bus(&self) -> &B {
+        &self.bus
+    }
+
+    /// The register bus, mutably.
+    pub fn bus_mut(&mut self) -> &mut B {
+        &mut self.bus
+    }
+
+    /// The fabric.
+    pub fn fabric(&self) -> &F {
+        &self.fabric
+    }
+
+    /// Validates `config` and writes it to the fabric's registers.
+    pub fn configure(&mut self, config: &FabricConfig) -> Result<(), DriverError> {
+        config
+            .write_to(&mut self.bus)
+            .map_err(DriverError::Registers)
+    }
+
+    /// Writes a register on the host's behalf; `false` (and nothing written) when no register
+    /// lives at `addr`.
+    pub fn write_register(&mut self, addr: u16, value: u32) -> bool {
+        let mapped = is_register(addr);
+        if mapped {
+            self.bus.write(addr, value);
+        }
+        mapped
+    }
+
+    /// Answers a packet from the host: `Hello` with `Hello`, `RegisterRead` with
+    /// `RegisterValue`, `RegisterWrite` silently; an unknown register address with
+    /// `ErrorReport(UnknownRegister)`, a device-to-host kind with an `ErrorReport` naming the
+    /// kind. An `ErrorReport` from the host needs no answer.
+    pub fn handle_host_packet<S: ByteSink>(
+        &mut self,
+        packet: &PacketRepr<'_>,
+        out: &mut PacketWriter<S>,
+    ) -> Result<(), DriverError> {
+        let answer = match *packet {
+            PacketRepr::Hello(_) => PacketRepr::Hello(HelloRepr {
+                version: PROTOCOL_VERSION,
+                capabilities: self.capabilities,
+            }),
+            PacketRepr::RegisterWrite(w) => {
+                if self.write_register(w.addr, w.value) {
+                    return Ok(());
+                }
+                unknown_register(w.addr)
+            }
+            PacketRepr::RegisterRead(r) if is_register(r.addr) => {
+                PacketRepr::RegisterValue(RegisterValueRepr {
+                    addr: r.addr,
+                    value: self.bus.read(r.addr),
+                })
+            }
+            PacketRepr::RegisterRead(r) => unknown_register(r.addr),
+            PacketRepr::ErrorReport(_) => return Ok(()),
+            ref other => PacketRepr::ErrorReport(ErrorReportRepr {
+                code: ErrorCode::Unknown(ERROR_UNEXPECTED_KIND),
+                detail: u32::from(u8::from(other.kind())),
+            }),
+        };
+        send(out, &answer)
+    }
+
+    /// Runs one `width * height` image (raster order, 8-bit grey) through the fabric with the
+    /// configuration its registers hold, and sends FrameStart, the frame's PointBatch and
+    /// SobelRows/SobelPatch packets (as OUTPUT_MODE.SOBEL_OUTPUT says), then FrameEnd.
+    ///
+    /// An error before FrameStart sends nothing; an error after it leaves the frame without a
+    /// FrameEnd (the caller reports the error). Either way the frame number is used up.
+    pub fn process_frame<S: ByteSink>(
+        &mut self,
+        image: &[u8],
+        timestamp_us: u64,
+        out: &mut PacketWriter<S>,
+    ) -> Result<FrameSummary, DriverError> {
+        let registers = FabricConfig::read_from(&mut self.bus).map_err(DriverError::Registers)?;
+        if usize::from(registers.width) > W0 {
+            return Err(DriverError::TooWide {
+                width: registers.width,
+                max: W0,
+            });
+        }
+        let width = usize::from(registers.width);
+        let expected = width * usize::from(registers.height);
+        if image.len() != expected {
+            return Err(DriverError::ImageSize {
+                expected,
+                got: image.len(),
+            });
+        }
+        let config = fabric_config(&registers);
+        self.fabric
+            .start_frame(&config)
+            .map_err(DriverError::FabricConfig)?;
+        self.ring
+            .start(registers.width, registers.height, registers.octaves);
+        self.patches.clear();
+        self.batch.clear();
+        self.frame = FrameState {
+            id: self.next_frame_id,
+            mode: registers.sobel_output,
+            sobel_scale: registers.sobel_scale,
+            points: 0,
+            sobel_packets: 0,
+            patches_dropped: 0,
+        };
+        self.next_frame_id = self.next_frame_id.wrapping_add(1);
+
+        send(
+            out,
+            &PacketRepr::FrameStart(FrameStartRepr {
+                frame_id: self.frame.id,
+                camera: self.camera,
+                width: registers.width,
+                height: registers.height,
+                octaves: registers.octaves,
+                timestamp_us,
+            }),
+        )?;
+        for row in image.chunks_exact(width) {
+            self.fabric.push_row(row).map_err(DriverError::Frame)?;
+            self.drain(out)?;
+        }
+        let mut flushed = false;
+        for _ in 0..flush_rows(registers.height) {
+            flushed = self.fabric.blank_row();
+            self.drain(out)?;
+            if flushed {
+                break;
+            }
+        }
+        if !flushed {
+            return Err(DriverError::Frame(FrameError::FlushTimeout));
+        }
+        for completed in self.ring.finish().into_iter().flatten() {
+            self.rows_completed(completed, out)?;
+        }
+        while let Some(patch) = self.patches.take_first(|_| true) {
+            self.send_patch(&patch, out)?;
+        }
+        self.send_points(out)?;
+
+        let overflow = self.fabric.overflow();
+        let dropped_sobel = overflow.sobel.saturating_add(self.frame.patches_dropped);
+        let mut flags = FrameEndFlags(0);
+        if overflow.points > 0 {
+            flags = flags | FrameEndFlags::POINT_FIFO_OVERFLOW;
+        }
+        if dropped_sobel > 0 {
+            flags = flags | FrameEndFlags::SOBEL_FIFO_OVERFLOW;
+        }
+        send(
+            out,
+            &PacketRepr::FrameEnd(FrameEndRepr {
+                frame_id: self.frame.id,
+                camera: self.camera,
+                point_count: self.frame.points,
+                sobel_count: self.frame.sobel_packets,
+                flags,
+                dropped_points: overflow.points,
+                dropped_sobel,
+            }),
+        )?;
+        Ok(FrameSummary {
+            frame_id: self.frame.id,
+            points: self.frame.points,
+            sobel_packets: self.frame.sobel_packets,
+            overflow,
+            patches_dropped: self.frame.patches_dropped,
+        })
+    }
+
+    /// Empties both FIFOs, points first.
+    fn drain<S: ByteSink>(&mut self, out: &mut PacketWriter<S>) -> Result<(), DriverError> {
+        while let Some(point) = self.fabric.pop_point() {
+            self.on_point(&point, out)?;
+        }
+        while let Some(pixel) = self.fabric.pop_sobel() {
+            self.on_sobel(&pixel, out)?;
+        }
+        Ok(())
+    }
+
+    fn on_point<S: ByteSink>(
+        &mut self,
+        point: &Extremum,
+        out: &mut PacketWriter<S>,
+    ) -> Result<(), DriverError> {
+        let outside = DriverError::PointOutOfFrame {
+            octave: point.octave,
+            x: point.x,
+            y: point.y,
+        };
+        if point.octave >= self.ring.octaves() {
+            return Err(outside);
+        }
+        let (width, height) = self.ring.dims(point.octave);
+        if point.x >= width || point.y >= height {
+            return Err(outside);
+        }
+        let index = self.frame.points;
+        self.frame.points = self.frame.points.saturating_add(1);
+        if self.batch.push(wire_point(point)) {
+            self.send_points(out)?;
+        }
+        if self.frame.mode != SobelOutput::Patches {
+            return Ok(());
+        }
+        let Ok(index) = u16::try_from(index) else {
+            // SobelPatch numbers points with 16 bits; later points cannot be referenced.
+            self.frame.patches_dropped = self.frame.patches_dropped.saturating_add(1);
+            return Ok(());
+        };
+        let pending = PendingPatch {
+            index,
+            octave: point.octave,
+            x: point.x,
+            y: point.y,
+        };
+        if self.ring.next_row(point.octave) >= pending.rows_needed_before(height) {
+            self.send_patch(&pending, out)
+        } else if self.patches.push(pending).is_err() {
+            self.frame.patches_dropped = self.frame.patches_dropped.saturating_add(1);
+            Ok(())
+        } else {
+            Ok(())
+        }
+    }
+
+    fn on_sobel<S: ByteSink>(
+        &mut self,
+        pixel: &FabricSobel,
+        out: &mut PacketWriter<S>,
+    ) -> Result<(), DriverError> {
+        match self.ring.push(pixel) {
+            Ok(Some(completed)) => self.rows_completed(completed, out),
+            Ok(None) => Ok(()),
+            Err(e) => Err(DriverError::SobelOutOfOrder(e)),
+        }
+    }
+
+    /// Sends completed rows (rows mode) or the patches they made ready (patch mode).
+    fn rows_completed<S: ByteSink>(
+        &mut self,
+        completed: Completed,
+        out: &mut PacketWriter<S>,
+    ) -> Result<(), DriverError> {
+        let octave = completed.octave;
+        match self.frame.mode {
+            SobelOutput::Rows => {
+                for row in completed.rows {
+                    // A row whose every pixel the FIFO dropped is not sent (FrameEnd counts it).
+                    let Some(pixels) = self.ring.row(octave, row) else {
+                        continue;
+                    };
+                    send(
+                        out,
+                        &PacketRepr::SobelRows(SobelRowsRepr {
+                            frame_id: self.frame.id,
+                            camera: self.camera,
+                            octave,
+                            scale: self.frame.sobel_scale,
+                            row,
+                            pixels: Records::Values(pixels),
+                        }),
+                    )?;
+                    self.frame.sobel_packets = self.frame.sobel_packets.saturating_add(1);
+                }
+            }
+            SobelOutput::Patches => {
+                let done = self.ring.next_row(octave);
+                let (_, height) = self.ring.dims(octave);
+                while let Some(patch) = self
+                    .patches
+                    .take_first(|p| p.octave == octave && done >= p.rows_needed_before(height))
+                {
+                    self.send_patch(&patch, out)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Cuts and sends one patch, or counts it when its top rows have left the ring.
+    fn send_patch<S: ByteSink>(
+        &mut self,
+        patch: &PendingPatch,
+        out: &mut PacketWriter<S>,
+    ) -> Result<(), DriverError> {
+        let (_, height) = self.ring.dims(patch.octave);
+        let top_held = patch.first_row() >= self.ring.oldest_row(patch.octave);
+        let top_in_image = patch.first_row() < height;
+        if !(top_held && top_in_image) {
+            self.frame.patches_dropped = self.frame.patches_dropped.saturating_add(1);
+            return Ok(());
+        }
+        self.ring.window(
+            patch.octave,
+            i32::from(patch.x) - i32::from(HALF),
+            i32::from(patch.y) - i32::from(HALF),
+            PATCH_SIZE,
+            &mut self.patch,
+        );
+        send(
+            out,
+            &PacketRepr::SobelPatch(SobelPatchRepr {
+                frame_id: self.frame.id,
+                camera: self.camera,
+                point_index: patch.index,
+                octave: patch.octave,
+                scale: self.frame.sobel_scale,
+                x: patch.x,
+                y: patch.y,
+                pixels: Records::Values(&self.patch),
+            }),
+        )?;
+        self.frame.sobel_packets = self.frame.sobel_packets.saturating_add(1);
+        Ok(())
+    }
+
+    /// Sends the collected points, if any.
+    fn send_points<S: ByteSink>(&mut self, out: &mut PacketWriter<S>) -> Result<(), DriverError> {
+        if self.batch.points().is_empty() {
+            return Ok(());
+        }
+        send(
+            out,
+            &PacketRepr::PointBatch(PointBatchRepr {
+                frame_id: self.frame.id,
+                camera: self.camera,
+                points: Records::Values(self.batch.points()),
+            }),
+        )?;
+        self.batch.clear();
+        Ok(())
+    }
+}
+
+/// Blank rows after the last input row within which the fabric must have emitted everything:
+/// octave `k` drains in about `10 * 2^k` input rows, so `4 * height + 64` is generous (the
+/// bound the fabric's own `run_frame` uses).
+fn flush_rows(height: u16) -> u32 {
+    4 * u32::from(height) + 64
+}
+
+fn is_register(addr: u16) -> bool {
+    addr % 4 == 0 && register_at(addr).is_some()
+}
+
+fn unknown_register(addr: u16) -> PacketRepr<'static> {
+    PacketRepr::ErrorReport(ErrorReportRepr {
+        code: ErrorCode::UnknownRegister,
+        detail: u32::from(addr),
+    })
+}
+
+fn send<S: ByteSink>(
+    out: &mut PacketWriter<S>,
+    packet: &PacketRepr<'_>,
+) -> Result<(), DriverError> {
+    out.send(packet).map_err(DriverError::Encode)
+}

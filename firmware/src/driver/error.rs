@@ -1,0 +1,161 @@
+//! What can stop the driver, and how each failure is reported to the host.
+
+use core::fmt;
+
+use stereocal_hdl::regs;
+use stereocal_wire::ErrorCode;
+
+use crate::driver::sobel_ring::OutOfOrder;
+use crate::fabric::{ConfigError, FrameError};
+
+/// `ErrorReport` code: the fabric's registers hold a configuration it cannot run; `detail` is
+/// the byte offset of the register at fault. (Not yet in the wire spec's table; sent as
+/// `ErrorCode::Unknown(0x0100)`.)
+pub const ERROR_INVALID_CONFIG: u16 = 0x0100;
+/// `ErrorReport` code: the host sent a packet kind only the device sends; `detail` is the kind
+/// byte. (Not yet in the wire spec's table.)
+pub const ERROR_UNEXPECTED_KIND: u16 = 0x0101;
+/// `ErrorReport` code: a frame could not be processed (wrong image size, or a fabric model
+/// defect); `detail` is [`DriverError::detail`]. (Not yet in the wire spec's table.)
+pub const ERROR_FRAME_FAILED: u16 = 0x0102;
+
+/// Why the driver could not configure the fabric or process a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DriverError {
+    /// The fabric's registers hold an invalid configuration.
+    Registers(stereocal_hdl::Error),
+    /// The fabric model refused the configuration (its memories are too small for it).
+    FabricConfig(ConfigError),
+    /// The fabric model refused a row.
+    Frame(FrameError),
+    /// The image does not have `width * height` pixels.
+    ImageSize {
+        /// Pixels the configured frame has.
+        expected: usize,
+        /// Pixels given.
+        got: usize,
+    },
+    /// The frame is wider than the driver's Sobel ring (`W0`).
+    TooWide {
+        /// Configured width.
+        width: u16,
+        /// The ring's width.
+        max: usize,
+    },
+    /// The fabric emitted a Sobel pixel outside its octave's image or out of raster order
+    /// (a fabric model defect).
+    SobelOutOfOrder(OutOfOrder),
+    /// The fabric emitted a point outside its octave's image (a fabric model defect).
+    PointOutOfFrame {
+        /// The point's octave.
+        octave: u8,
+        /// Its column.
+        x: u16,
+        /// Its row.
+        y: u16,
+    },
+    /// A packet could not be encoded (a driver defect: every packet is built within the wire
+    /// format's limits).
+    Encode(stereocal_wire::Error),
+}
+
+impl DriverError {
+    /// The `ErrorReport` code and detail that tell the host about this error.
+    pub fn report(&self) -> (ErrorCode, u32) {
+        match self {
+            Self::Registers(e) => (
+                ErrorCode::Unknown(ERROR_INVALID_CONFIG),
+                register_offset(e).map_or(u32::MAX, u32::from),
+            ),
+            Self::TooWide { .. } | Self::FabricConfig(_) => (
+                ErrorCode::Unknown(ERROR_INVALID_CONFIG),
+                u32::from(regs::width::OFFSET),
+            ),
+            _ => (ErrorCode::Unknown(ERROR_FRAME_FAILED), self.detail()),
+        }
+    }
+
+    /// A number that tells the variants apart in an `ErrorReport`: the variant index in the
+    /// top byte and a variant-specific value (a size, a coordinate) below.
+    pub fn detail(&self) -> u32 {
+        let (variant, value): (u32, u32) = match *self {
+            Self::Registers(_) => (1, 0),
+            Self::FabricConfig(_) => (2, 0),
+            Self::Frame(_) => (3, 0),
+            Self::ImageSize { got, .. } => (4, got.min(0xFF_FFFF) as u32),
+            Self::TooWide { width, .. } => (5, u32::from(width)),
+            Self::SobelOutOfOrder(p) => (6, u32::from(p.y)),
+            Self::PointOutOfFrame { y, .. } => (7, u32::from(y)),
+            Self::Encode(_) => (8, 0),
+        };
+        (variant << 24) | value
+    }
+}
+
+/// The register an hdl error is about, where it names one.
+fn register_offset(e: &stereocal_hdl::Error) -> Option<u16> {
+    use stereocal_hdl::Error as E;
+    let field = match *e {
+        E::MisalignedOffset { offset } | E::UnmappedOffset { offset } => return Some(offset),
+        E::FrameNotDivisible { .. } => return Some(regs::width::OFFSET),
+        E::FieldOutOfRange { field, .. }
+        | E::FieldReadOnly { field }
+        | E::UnknownEnumValue { field, .. } => field,
+        _ => return None,
+    };
+    let register = field.split('.').next()?;
+    regs::REGISTERS
+        .iter()
+        .find(|r| r.name == register)
+        .map(|r| r.offset)
+}
+
+impl fmt::Display for DriverError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Registers(e) => write!(f, "fabric registers: {e}"),
+            Self::FabricConfig(e) => write!(f, "fabric model: {e}"),
+            Self::Frame(e) => write!(f, "fabric model: {e}"),
+            Self::ImageSize { expected, got } => {
+                write!(f, "image of {got} pixels, the configured frame has {expected}")
+            }
+            Self::TooWide { width, max } => {
+                write!(f, "frame width {width} exceeds the driver's Sobel ring ({max})")
+            }
+            Self::SobelOutOfOrder(p) => write!(
+                f,
+                "fabric emitted Sobel pixel ({}, {}) of octave {} out of raster order or outside the image",
+                p.x, p.y, p.octave
+            ),
+            Self::PointOutOfFrame { octave, x, y } => write!(
+                f,
+                "fabric emitted point ({x}, {y}) outside octave {octave}'s image"
+            ),
+            Self::Encode(e) => write!(f, "packet encoding: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for DriverError {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_errors_name_the_register() {
+        let e = DriverError::Registers(stereocal_hdl::Error::FieldOutOfRange {
+            field: "OCTAVES.COUNT",
+            value: 7,
+            min: 1,
+            max: 4,
+        });
+        assert_eq!(
+            e.report(),
+            (
+                ErrorCode::Unknown(ERROR_INVALID_CONFIG),
+                u32::from(regs::octaves::OFFSET)
+            )
+        );
+    }
+}

@@ -1,0 +1,104 @@
+//! A front end chosen at run time: the fast path (the default) or the register-level model.
+//!
+//! Both produce the same points and Sobel pixels; the register-level model is the clock-level
+//! specification of the RTL and is much slower, so the soft-core and the host run the fast
+//! path unless asked otherwise. The two interleave their octaves differently, so the packets
+//! of a frame come in a different order (same contents per row, patch and point).
+
+use crate::fabric::{
+    Config, ConfigError, Extremum, FastFrontEnd, FrameError, FrontEnd, Overflow, RegisterFrontEnd,
+    SobelPixel,
+};
+
+/// Which implementation of the fabric runs the frames.
+///
+/// The variants differ in size by a hundred-odd kilobytes of line memories; boxing is not an
+/// option without a heap, and a channel has exactly one of these for its whole life.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub enum FabricModel<
+    const W0: usize = 1280,
+    const W1: usize = 640,
+    const W2: usize = 320,
+    const W3: usize = 160,
+> {
+    /// Row-at-a-time implementation of the fabric's arithmetic.
+    Fast(FastFrontEnd<W0, W1, W2, W3>),
+    /// One clock per pixel, pipeline registers and line memories as in the RTL.
+    RegisterLevel(RegisterFrontEnd<W0, W1, W2, W3>),
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
+    FabricModel<W0, W1, W2, W3>
+{
+    /// The fast path.
+    pub const fn fast() -> Self {
+        Self::Fast(FastFrontEnd::new())
+    }
+
+    /// The register-level model.
+    pub const fn register_level() -> Self {
+        Self::RegisterLevel(RegisterFrontEnd::new())
+    }
+
+    fn front_end(&mut self) -> &mut dyn FrontEnd {
+        match self {
+            Self::Fast(fe) => fe,
+            Self::RegisterLevel(fe) => fe,
+        }
+    }
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> Default
+    for FabricModel<W0, W1, W2, W3>
+{
+    fn default() -> Self {
+        Self::fast()
+    }
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEnd
+    for FabricModel<W0, W1, W2, W3>
+{
+    fn start_frame(&mut self, config: &Config) -> Result<(), ConfigError> {
+        self.front_end().start_frame(config)
+    }
+
+    fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError> {
+        self.front_end().push_row(row)
+    }
+
+    fn blank_row(&mut self) -> bool {
+        self.front_end().blank_row()
+    }
+
+    fn frame_done(&self) -> bool {
+        match self {
+            Self::Fast(fe) => fe.frame_done(),
+            Self::RegisterLevel(fe) => fe.frame_done(),
+        }
+    }
+
+    fn pop_point(&mut self) -> Option<Extremum> {
+        self.front_end().pop_point()
+    }
+
+    fn pop_sobel(&mut self) -> Option<SobelPixel> {
+        self.front_end().pop_sobel()
+    }
+
+    fn overflow(&self) -> Overflow {
+        match self {
+            Self::Fast(fe) => fe.overflow(),
+            Self::RegisterLevel(fe) => fe.overflow(),
+        }
+    }
+
+    fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
+        self.front_end().drain_points(sink)
+    }
+
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
+        self.front_end().drain_sobel(sink)
+    }
+}

@@ -1,0 +1,93 @@
+//! Points waiting for the Sobel rows their 16x16 patch needs.
+//!
+//! A point at row `y` of its octave needs Sobel rows `y-8..=y+7` (clipped to the image). The
+//! fabric's point stream lags its Sobel stream by a few rows, so a point usually arrives with
+//! its top rows already in the [`SobelRing`](crate::driver::sobel_ring::SobelRing) and waits
+//! for the rows below it. A point whose top rows have already left the ring, or that finds
+//! the queue full, gets no patch; the driver counts it in `FrameEnd.dropped_sobel`.
+
+use stereocal_wire::PATCH_SIZE;
+
+/// Points that can wait at once: the fabric's point FIFO depth, so a full FIFO drained in one
+/// go never overflows the queue.
+pub const MAX_PENDING: usize = 512;
+
+/// Half the patch side: the centre pixel sits at (8, 8) of the patch.
+pub const HALF: u16 = (PATCH_SIZE / 2) as u16;
+
+/// A point waiting for its patch.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PendingPatch {
+    /// Position of the point in the frame's `PointBatch` order.
+    pub index: u16,
+    /// Its octave.
+    pub octave: u8,
+    /// Its column in the octave.
+    pub x: u16,
+    /// Its row in the octave.
+    pub y: u16,
+}
+
+impl PendingPatch {
+    /// First row the patch needs (clipped at the top).
+    pub fn first_row(&self) -> u16 {
+        self.y.saturating_sub(HALF)
+    }
+
+    /// The patch can be cut once rows before this one are complete (clipped at the bottom).
+    pub fn rows_needed_before(&self, height: u16) -> u16 {
+        (self.y + HALF).min(height)
+    }
+}
+
+/// A FIFO of pending patches, in point order.
+pub struct PatchQueue {
+    entries: [PendingPatch; MAX_PENDING],
+    len: usize,
+}
+
+impl PatchQueue {
+    /// An empty queue.
+    pub const fn new() -> Self {
+        Self {
+            entries: [PendingPatch {
+                index: 0,
+                octave: 0,
+                x: 0,
+                y: 0,
+            }; MAX_PENDING],
+            len: 0,
+        }
+    }
+
+    /// Empties the queue.
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// Queues `patch`; gives it back when the queue is full.
+    pub fn push(&mut self, patch: PendingPatch) -> Result<(), PendingPatch> {
+        let slot = self.entries.get_mut(self.len).ok_or(patch)?;
+        *slot = patch;
+        self.len += 1;
+        Ok(())
+    }
+
+    /// Removes and returns, in queue order, the first entry `ready` accepts.
+    pub fn take_first(
+        &mut self,
+        mut ready: impl FnMut(&PendingPatch) -> bool,
+    ) -> Option<PendingPatch> {
+        let i = self.entries[..self.len].iter().position(&mut ready)?;
+        let patch = self.entries[i];
+        self.entries.copy_within(i + 1..self.len, i);
+        self.len -= 1;
+        Some(patch)
+    }
+}
+
+impl Default for PatchQueue {
+    fn default() -> Self {
+        Self::new()
+    }
+}
