@@ -35,7 +35,11 @@ impl Probe for Collect {
     fn dog_row(&mut self, o: u8, d: u8, y: u16, row: &[i16]) {
         let img = &mut self.dog[o as usize][d as usize];
         for (x, &v) in row.iter().enumerate() {
-            img.put_pixel(x as u32, y as u32, Luma([(128 + (v as i32 >> 5)).clamp(0, 255) as u8]));
+            img.put_pixel(
+                x as u32,
+                y as u32,
+                Luma([(128 + (v as i32 >> 5)).clamp(0, 255) as u8]),
+            );
         }
     }
 }
@@ -61,7 +65,9 @@ fn main() -> Result<(), Box<dyn Error>> {
     let [_, input, out] = args.as_slice() else {
         return Err("usage: dump_pyramid <image> <outdir>".into());
     };
-    let grey = image::open(input).map_err(|e| format!("{input}: {e}"))?.into_luma8();
+    let grey = image::open(input)
+        .map_err(|e| format!("{input}: {e}"))?
+        .into_luma8();
     let (w, h) = grey.dimensions();
     if w > 1280 || h > u16::MAX as u32 {
         return Err(format!("{input}: {w}x{h} is wider than the 1280-pixel line buffers").into());
@@ -74,17 +80,26 @@ fn main() -> Result<(), Box<dyn Error>> {
     fe.start_frame(&cfg).map_err(|e| format!("{input}: {e}"))?;
     let dims: Vec<(u32, u32)> = (0..cfg.octaves)
         .map(|k| {
-            let (a, b) = stereocal_firmware::fabric::geometry::octave_dims(cfg.width, cfg.height, k);
+            let (a, b) =
+                stereocal_firmware::fabric::geometry::octave_dims(cfg.width, cfg.height, k);
             (a as u32, b as u32)
         })
         .collect();
     let mut probe = Collect {
-        scale: dims.iter().map(|&(a, b)| vec![GrayImage::new(a, b); 4]).collect(),
-        dog: dims.iter().map(|&(a, b)| vec![GrayImage::new(a, b); 3]).collect(),
+        scale: dims
+            .iter()
+            .map(|&(a, b)| vec![GrayImage::new(a, b); 4])
+            .collect(),
+        dog: dims
+            .iter()
+            .map(|&(a, b)| vec![GrayImage::new(a, b); 3])
+            .collect(),
     };
     let mut points: Vec<Extremum> = Vec::new();
     let mut sobel: Vec<SobelPixel> = Vec::new();
-    let drain = |fe: &mut FastFrontEnd<1280, 640, 320, 160>, p: &mut Vec<Extremum>, s: &mut Vec<SobelPixel>| {
+    let drain = |fe: &mut FastFrontEnd<1280, 640, 320, 160>,
+                 p: &mut Vec<Extremum>,
+                 s: &mut Vec<SobelPixel>| {
         while let Some(x) = fe.pop_point() {
             p.push(x);
         }
@@ -105,11 +120,12 @@ fn main() -> Result<(), Box<dyn Error>> {
         return Err(format!("FIFO overflow: {o:?}").into());
     }
 
-    let save = |img: &dyn Fn(&Path) -> image::ImageResult<()>, name: &str| -> Result<(), Box<dyn Error>> {
-        let p = out.join(name);
-        img(&p).map_err(|e| format!("{}: {e}", p.display()))?;
-        Ok(())
-    };
+    let save =
+        |img: &dyn Fn(&Path) -> image::ImageResult<()>, name: &str| -> Result<(), Box<dyn Error>> {
+            let p = out.join(name);
+            img(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+            Ok(())
+        };
 
     // Pyramid montage: octave k in row k, scales side by side.
     let (mw, mh) = (4 * w, dims.iter().map(|d| d.1).sum::<u32>());
@@ -117,7 +133,12 @@ fn main() -> Result<(), Box<dyn Error>> {
     let mut y0 = 0;
     for (k, &(ow, oh)) in dims.iter().enumerate() {
         for s in 0..4 {
-            image::imageops::replace(&mut montage, &probe.scale[k][s], (s as u32 * ow) as i64, y0 as i64);
+            image::imageops::replace(
+                &mut montage,
+                &probe.scale[k][s],
+                (s as u32 * ow) as i64,
+                y0 as i64,
+            );
         }
         y0 += oh;
         let mut d = GrayImage::new(3 * ow, oh);
@@ -139,7 +160,11 @@ fn main() -> Result<(), Box<dyn Error>> {
         let cy = (p.y as f32 + p.dy.to_num::<f32>()) * s;
         let r = 2.0 * s;
         let lum = 155 + 25 * p.octave;
-        let col = if p.dog > 0 { Rgb([lum, 30, 30]) } else { Rgb([30, 60, lum]) };
+        let col = if p.dog > 0 {
+            Rgb([lum, 30, 30])
+        } else {
+            Rgb([30, 60, lum])
+        };
         for a in 0..64 {
             let t = a as f32 / 64.0 * std::f32::consts::TAU;
             let (x, y) = (cx + r * t.cos(), cy + r * t.sin());
@@ -155,13 +180,24 @@ fn main() -> Result<(), Box<dyn Error>> {
         let mut mag = GrayImage::new(ow, oh);
         let mut ori = RgbImage::new(ow, oh);
         for s in sobel.iter().filter(|s| s.octave as usize == k) {
-            mag.put_pixel(s.x as u32, s.y as u32, Luma([s.magnitude.saturating_mul(4)]));
+            mag.put_pixel(
+                s.x as u32,
+                s.y as u32,
+                Luma([s.magnitude.saturating_mul(4)]),
+            );
             ori.put_pixel(s.x as u32, s.y as u32, hue(s.orientation, s.magnitude));
         }
         save(&|p| mag.save(p), &format!("sobel_mag_o{k}.png"))?;
         save(&|p| ori.save(p), &format!("sobel_ori_o{k}.png"))?;
     }
-    let per: Vec<usize> = (0..cfg.octaves).map(|k| points.iter().filter(|p| p.octave == k).count()).collect();
-    println!("{input}: {w}x{h}, {} points per octave {per:?}, {} Sobel pixels -> {}", points.len(), sobel.len(), out.display());
+    let per: Vec<usize> = (0..cfg.octaves)
+        .map(|k| points.iter().filter(|p| p.octave == k).count())
+        .collect();
+    println!(
+        "{input}: {w}x{h}, {} points per octave {per:?}, {} Sobel pixels -> {}",
+        points.len(),
+        sobel.len(),
+        out.display()
+    );
     Ok(())
 }

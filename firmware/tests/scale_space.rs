@@ -59,7 +59,14 @@ fn blobs_are_found_at_the_predicted_octave_and_position() {
         let img = blob(w, h, sigma);
         let cfg = Config::new(w as u16, h as u16);
         let mut pts: Vec<Extremum> = Vec::new();
-        run_frame(&mut *fe, &cfg, &img, &mut |p| pts.push(p), &mut |_| {}).unwrap();
+        run_frame(
+            &mut *fe,
+            &cfg,
+            &img,
+            &mut |p| pts.extend_from_slice(p),
+            &mut |_| {},
+        )
+        .unwrap();
         let near: Vec<&Extremum> = pts
             .iter()
             .filter(|p| {

@@ -54,6 +54,44 @@ impl<T: Copy, const W: usize, const LINES: usize> LineFifo<T, W, LINES> {
         Ok(())
     }
 
+    /// Free entries.
+    pub fn free(&self) -> usize {
+        Self::CAPACITY - self.len
+    }
+
+    /// Appends `n` entries `f(0), f(1), ..` (the caller checked `n <= self.free()`), writing
+    /// the at most two contiguous runs of the ring directly.
+    #[inline]
+    pub fn extend_with(&mut self, n: usize, mut f: impl FnMut(usize) -> T) {
+        debug_assert!(n <= self.free());
+        let mut start = self.head + self.len;
+        if start >= Self::CAPACITY {
+            start -= Self::CAPACITY;
+        }
+        let first = n.min(Self::CAPACITY - start);
+        let mem = self.mem.as_flattened_mut();
+        for (i, slot) in mem[start..start + first].iter_mut().enumerate() {
+            *slot = f(i);
+        }
+        for (i, slot) in mem[..n - first].iter_mut().enumerate() {
+            *slot = f(first + i);
+        }
+        self.len += n;
+    }
+
+    /// Hands every entry, oldest first, to `sink` as at most two slices, and empties the FIFO.
+    pub fn drain_slices(&mut self, sink: &mut dyn FnMut(&[T])) {
+        let mem = self.mem.as_flattened();
+        let first = self.len.min(Self::CAPACITY - self.head);
+        if first > 0 {
+            sink(&mem[self.head..self.head + first]);
+        }
+        if self.len > first {
+            sink(&mem[..self.len - first]);
+        }
+        self.clear();
+    }
+
     /// Removes the oldest entry.
     #[inline]
     pub fn pop(&mut self) -> Option<T> {

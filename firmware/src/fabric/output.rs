@@ -135,6 +135,31 @@ impl<const W0: usize> OutputFifos<W0> {
         }
     }
 
+    /// Enqueues a row of Sobel pixels `(i, y)` of `octave`; what does not fit is counted.
+    #[inline]
+    pub fn push_sobel_row(&mut self, octave: u8, y: u16, magnitude: &[u8], orientation: &[u8]) {
+        let n = magnitude.len().min(orientation.len());
+        let fit = n.min(self.sobel.free());
+        self.sobel.extend_with(fit, |i| SobelPixel {
+            octave,
+            orientation: orientation[i],
+            magnitude: magnitude[i],
+            x: i as u16,
+            y,
+        });
+        self.overflow.sobel = self.overflow.sobel.saturating_add((n - fit) as u32);
+    }
+
+    /// Hands all queued points to `sink` (at most two slices) and empties the FIFO.
+    pub fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
+        self.points.drain_slices(sink);
+    }
+
+    /// Hands all queued Sobel pixels to `sink` (at most two slices) and empties the FIFO.
+    pub fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
+        self.sobel.drain_slices(sink);
+    }
+
     /// Oldest point.
     #[inline]
     pub fn pop_point(&mut self) -> Option<Extremum> {
@@ -205,16 +230,21 @@ pub trait FrontEnd {
     fn pop_sobel(&mut self) -> Option<SobelPixel>;
     /// Items dropped so far this frame.
     fn overflow(&self) -> Overflow;
+    /// Hands every queued point to `sink`, oldest first, in at most two slices.
+    fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum]));
+    /// Hands every queued Sobel pixel to `sink`, oldest first, in at most two slices.
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel]));
 }
 
 /// Runs a whole `config.width x config.height` frame through `fe`, draining the FIFOs after
-/// every row into the two callbacks. Returns the overflow counters.
+/// every row into the two callbacks (slices of consecutive items, oldest first). Returns the
+/// overflow counters.
 pub fn run_frame<F: FrontEnd + ?Sized>(
     fe: &mut F,
     config: &Config,
     image: &[u8],
-    on_point: &mut dyn FnMut(Extremum),
-    on_sobel: &mut dyn FnMut(SobelPixel),
+    on_points: &mut dyn FnMut(&[Extremum]),
+    on_sobel: &mut dyn FnMut(&[SobelPixel]),
 ) -> Result<Overflow, FrameError> {
     let (w, h) = (config.width as usize, config.height as usize);
     if image.len() != w * h {
@@ -225,12 +255,8 @@ pub fn run_frame<F: FrontEnd + ?Sized>(
     }
     fe.start_frame(config).map_err(FrameError::Config)?;
     let mut drain = |fe: &mut F| {
-        while let Some(p) = fe.pop_point() {
-            on_point(p);
-        }
-        while let Some(s) = fe.pop_sobel() {
-            on_sobel(s);
-        }
+        fe.drain_points(on_points);
+        fe.drain_sobel(on_sobel);
     };
     for row in image.chunks_exact(w) {
         fe.push_row(row)?;

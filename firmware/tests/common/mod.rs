@@ -14,11 +14,15 @@ pub struct FrameOut {
 }
 
 pub fn run<F: FrontEnd + ?Sized>(fe: &mut F, cfg: &Config, img: &[u8]) -> FrameOut {
-    let mut points = Vec::new();
-    let mut sobel = Vec::new();
-    let overflow = run_frame(fe, cfg, img, &mut |p| points.push(p), &mut |s| {
-        sobel.push(s)
-    })
+    let mut points: Vec<Extremum> = Vec::new();
+    let mut sobel: Vec<SobelPixel> = Vec::new();
+    let overflow = run_frame(
+        fe,
+        cfg,
+        img,
+        &mut |p| points.extend_from_slice(p),
+        &mut |s| sobel.extend_from_slice(s),
+    )
     .expect("frame runs");
     points.sort_by_key(|p| p.octave);
     sobel.sort_by_key(|s| s.octave);

@@ -12,11 +12,12 @@ fn clamp(i: isize, last: usize) -> usize {
     i.clamp(0, last as isize) as usize
 }
 
+/// Five 16x16-bit products widened to 32 bits (the form SSE2 multiplies with
+/// `pmullw`/`pmulhuw`), summed and rounded exactly like the DA stage.
 #[inline(always)]
 fn dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u16 {
-    let s = t[0] as u32 * (a as u32 + e as u32)
-        + t[1] as u32 * (b as u32 + d as u32)
-        + t[2] as u32 * c as u32;
+    let m = |t: u16, v: u16| t as u32 * v as u32;
+    let s = m(t[0], a) + m(t[1], b) + m(t[2], c) + m(t[3], d) + m(t[4], e);
     ((s + ROUND) >> TAP_BITS) as u16
 }
 
@@ -123,11 +124,12 @@ pub fn cordic_row(sx: &[i32], sy: &[i32], magnitude: &mut [u8], orientation: &mu
         let s = fold_select(sx[i], sy[i]);
         let (mut x, mut y, mut z) = (s.x, s.y, s.z as i32);
         for (k, &a) in ATAN_BAM16.iter().enumerate() {
-            let sign = 1 | (y >> 31); // +1 when y >= 0, -1 otherwise
+            // m = 0 when y >= 0 (rotate clockwise), -1 otherwise; (v ^ m) - m is ±v.
+            let m = y >> 31;
             let (dx, dy) = (y >> k, x >> k);
-            x += sign * dx;
-            y -= sign * dy;
-            z += sign * a as i32;
+            x += (dx ^ m) - m;
+            y -= (dy ^ m) - m;
+            z += (a as i32 ^ m) - m;
         }
         let mag = (x >> 1) + (x >> 3);
         magnitude[i] = ((mag + 512) >> 10).clamp(0, 255) as u8;

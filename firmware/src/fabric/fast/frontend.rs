@@ -161,4 +161,12 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
     fn overflow(&self) -> Overflow {
         self.fifos.overflow()
     }
+
+    fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
+        self.fifos.drain_points(sink);
+    }
+
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
+        self.fifos.drain_sobel(sink);
+    }
 }

@@ -11,7 +11,7 @@ use crate::fabric::extrema::{is_extremum, Cube};
 use crate::fabric::fast::filter::{column_filter, cordic_row, dog_row, row_filter, sobel_row};
 use crate::fabric::fast::probe::Probe;
 use crate::fabric::geometry::octave_dims;
-use crate::fabric::output::{Extremum, OutputFifos, SobelPixel};
+use crate::fabric::output::{Extremum, OutputFifos};
 use crate::fabric::refine::refine;
 use crate::fabric::taps::GAUSS_TAPS;
 
@@ -211,19 +211,7 @@ impl<const W: usize> FastOctave<W> {
             &mut self.magnitude[..w],
             &mut self.orientation[..w],
         );
-        for (x, (&magnitude, &orientation)) in self.magnitude[..w]
-            .iter()
-            .zip(&self.orientation[..w])
-            .enumerate()
-        {
-            out.push_sobel(SobelPixel {
-                octave: self.index,
-                orientation,
-                magnitude,
-                x: x as u16,
-                y: r,
-            });
-        }
+        out.push_sobel_row(self.index, r, &self.magnitude[..w], &self.orientation[..w]);
         self.sobel_rows += 1;
     }
 
@@ -248,15 +236,19 @@ impl<const W: usize> FastOctave<W> {
         let rows = [(r as usize - 2) % 3, (r as usize - 1) % 3, r as usize % 3];
         let thr = self.config.contrast_threshold as i32;
         for x in 1..w - 1 {
-            // Necessary conditions first (contrast, then the two row neighbours), so the
+            // Necessary conditions first (contrast, then the four direct neighbours), so the
             // 26-neighbour test only runs on the few survivors; the verdict is unchanged.
             let row = &self.dog[1][rows[1]];
             let v = row[x] as i32;
             let (l, r) = (row[x - 1] as i32, row[x + 1] as i32);
+            let (u, d) = (
+                self.dog[1][rows[0]][x] as i32,
+                self.dog[1][rows[2]][x] as i32,
+            );
             let maybe = if v > thr {
-                l < v && r < v
+                l < v && r < v && u < v && d < v
             } else if v < -thr {
-                l > v && r > v
+                l > v && r > v && u > v && d > v
             } else {
                 false
             };
