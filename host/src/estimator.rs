@@ -12,10 +12,10 @@ use crate::descriptor::{describe, DescriptorConfig};
 use crate::essential::constrained::{self, VergeAngles};
 use crate::essential::general::{self, RelativePose, YawPitchRoll};
 use crate::essential::{cauchy_cost, Correspondence, EssentialError, RefineConfig};
-use crate::frame::FeatureFrame;
+use crate::frame::{FeatureFrame, SobelPlane};
 use crate::matching::{match_descriptors, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
-use crate::subpixel::{refine_pair, SubpixelConfig};
+use crate::subpixel::{guided_pair, refine_pair, SubpixelConfig};
 
 /// A matched point pair in full-resolution pixels: (left, right).
 pub type PixelPair = ([f64; 2], [f64; 2]);
@@ -45,6 +45,31 @@ pub struct EstimatorConfig {
     pub model: Model,
     /// Fewer matches (after refinement) or inliers than this → no estimate for the frame.
     pub min_matches: usize,
+    /// Guided matching of the keypoints the descriptors left unmatched (needs Sobel planes).
+    pub guided: Option<GuidedConfig>,
+}
+
+/// Guided matching: every left keypoint without a descriptor match is searched for in the
+/// right magnitude plane around the position its matched neighbours predict. More matches
+/// lower the noise of the verge estimate roughly as 1/√N.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GuidedConfig {
+    /// Matched neighbours whose median disparity predicts the position.
+    pub neighbours: usize,
+    /// Horizontal search range around the prediction (pixels).
+    pub search_px: i32,
+    /// Only neighbours within this distance (pixels) are used.
+    pub max_neighbour_distance_px: f32,
+}
+
+impl Default for GuidedConfig {
+    fn default() -> Self {
+        Self {
+            neighbours: 5,
+            search_px: 6,
+            max_neighbour_distance_px: 80.0,
+        }
+    }
 }
 
 impl Default for EstimatorConfig {
@@ -58,6 +83,7 @@ impl Default for EstimatorConfig {
             refine: RefineConfig::default(),
             model: Model::Constrained,
             min_matches: 12,
+            guided: Some(GuidedConfig::default()),
         }
     }
 }
@@ -152,7 +178,16 @@ impl VergeEstimator {
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> Result<FrameEstimate, EstimateError> {
-        let (matches, pairs) = self.point_pairs(left, right);
+        let (matches, mut pairs) = self.point_pairs(left, right);
+        if let (Some(g), Some(sub), Some(pl), Some(pr)) = (
+            self.config.guided,
+            self.config.subpixel,
+            left.plane(0),
+            right.plane(0),
+        ) {
+            let extra = guided_pairs(left, &matches, &pairs, pl, pr, &g, &sub);
+            pairs.extend(extra);
+        }
         let mut est = self.estimate_from_pixels(&pairs)?;
         est.matches = matches.len();
         Ok(est)
@@ -233,6 +268,72 @@ impl VergeEstimator {
         }
         Ok(est)
     }
+}
+
+/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]).
+fn guided_pairs(
+    left: &FeatureFrame,
+    matches: &[Match],
+    pairs: &[PixelPair],
+    pl: &SobelPlane,
+    pr: &SobelPlane,
+    g: &GuidedConfig,
+    sub: &SubpixelConfig,
+) -> Vec<PixelPair> {
+    if pairs.len() < g.neighbours {
+        return Vec::new();
+    }
+    let mut matched = vec![false; left.keypoints().len()];
+    for m in matches {
+        matched[m.left as usize] = true;
+    }
+    let max_d2 = g.max_neighbour_distance_px * g.max_neighbour_distance_px;
+    let mut near: Vec<(f32, usize)> = Vec::with_capacity(pairs.len());
+    let mut taken: Vec<[f32; 2]> = pairs
+        .iter()
+        .map(|(l, _)| [l[0] as f32, l[1] as f32])
+        .collect();
+    let mut out = Vec::new();
+    for (k, kp) in left.keypoints().iter().enumerate() {
+        if matched[k] {
+            continue;
+        }
+        // Several keypoints (octaves) can sit on the same pixel: use each location once.
+        if taken
+            .iter()
+            .any(|t| (t[0] - kp.x).abs() < 1.5 && (t[1] - kp.y).abs() < 1.5)
+        {
+            continue;
+        }
+        near.clear();
+        near.extend(pairs.iter().enumerate().filter_map(|(i, (l, _))| {
+            let d2 = (l[0] as f32 - kp.x).powi(2) + (l[1] as f32 - kp.y).powi(2);
+            (d2 <= max_d2).then_some((d2, i))
+        }));
+        if near.len() < g.neighbours {
+            continue;
+        }
+        near.select_nth_unstable_by(g.neighbours - 1, |a, b| a.0.total_cmp(&b.0));
+        let mut du: Vec<f32> = near[..g.neighbours]
+            .iter()
+            .map(|&(_, i)| (pairs[i].1[0] - pairs[i].0[0]) as f32)
+            .collect();
+        let mut dv: Vec<f32> = near[..g.neighbours]
+            .iter()
+            .map(|&(_, i)| (pairs[i].1[1] - pairs[i].0[1]) as f32)
+            .collect();
+        du.sort_by(f32::total_cmp);
+        dv.sort_by(f32::total_cmp);
+        let guess = [kp.x + du[du.len() / 2], kp.y + dv[dv.len() / 2]];
+        if let Some(r) = guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, sub) {
+            taken.push(r.left);
+            out.push((
+                [r.left[0] as f64, r.left[1] as f64],
+                [r.right[0] as f64, r.right[1] as f64],
+            ));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -28,7 +28,7 @@ pub struct KalmanConfig {
 impl Default for KalmanConfig {
     fn default() -> Self {
         Self {
-            process_noise: 0.25,
+            process_noise: 0.1,
             min_measurement_sigma_deg: 0.01,
             gate_sigmas: 4.0,
             initial_rate_sigma: 10.0,

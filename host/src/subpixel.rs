@@ -196,6 +196,105 @@ pub fn refine_pair(
     })
 }
 
+/// Normalised cross-correlation of the `(2·half+1)²` windows of two planes at integer centres,
+/// `None` when a window leaves its plane or is flat.
+fn ncc_at(
+    a: &SobelPlane,
+    ax: i32,
+    ay: i32,
+    b: &SobelPlane,
+    bx: i32,
+    by: i32,
+    half: i32,
+) -> Option<f32> {
+    let inside = |p: &SobelPlane, x: i32, y: i32| {
+        x - half >= 0
+            && y - half >= 0
+            && x + half < p.width() as i32
+            && y + half < p.height() as i32
+    };
+    if !inside(a, ax, ay) || !inside(b, bx, by) {
+        return None;
+    }
+    let (wa, wb) = (a.width() as i32, b.width() as i32);
+    let (ma, mb) = (a.magnitude(), b.magnitude());
+    let (mut sa, mut sb, mut saa, mut sbb, mut sab) = (0f32, 0f32, 0f32, 0f32, 0f32);
+    for dy in -half..=half {
+        let ra = ((ay + dy) * wa + ax - half) as usize;
+        let rb = ((by + dy) * wb + bx - half) as usize;
+        let len = (2 * half + 1) as usize;
+        for (&x, &y) in ma[ra..ra + len].iter().zip(&mb[rb..rb + len]) {
+            let (x, y) = (x as f32, y as f32);
+            sa += x;
+            sb += y;
+            saa += x * x;
+            sbb += y * y;
+            sab += x * y;
+        }
+    }
+    let n = ((2 * half + 1) * (2 * half + 1)) as f32;
+    let va = saa - sa * sa / n;
+    let vb = sbb - sb * sb / n;
+    if va <= 0.0 || vb <= 0.0 {
+        return None;
+    }
+    Some((sab - sa * sb / n) / (va * vb).sqrt())
+}
+
+/// Guided matching for a left point without a descriptor match: searches `±search_px`
+/// horizontally around the predicted right position `guess` (from neighbouring matches) for
+/// the best correlation of the magnitude windows, requires it to beat every other local
+/// maximum clearly, then refines it with [`refine_pair`].
+pub fn guided_pair(
+    left_plane: &SobelPlane,
+    right_plane: &SobelPlane,
+    left: [f32; 2],
+    guess: [f32; 2],
+    search_px: i32,
+    config: &SubpixelConfig,
+) -> Option<RefinedPair> {
+    let half = config.half_window as i32;
+    let (lx, ly) = (left[0].round() as i32, left[1].round() as i32);
+    let gy = (guess[1] + (ly as f32 - left[1])).round() as i32;
+    let gx = (guess[0] + (lx as f32 - left[0])).round() as i32;
+    let scores: Vec<(i32, f32)> = (-search_px..=search_px)
+        .filter_map(|dx| {
+            Some((
+                dx,
+                ncc_at(left_plane, lx, ly, right_plane, gx + dx, gy, half)?,
+            ))
+        })
+        .collect();
+    let (best_i, &(best_dx, best)) = scores
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1 .1.total_cmp(&b.1 .1))?;
+    // The strongest other local maximum of the correlation: a second peak means repetitive
+    // texture along the search line.
+    let runner_up = (0..scores.len())
+        .filter(|&i| i != best_i)
+        .filter(|&i| {
+            let v = scores[i].1;
+            (i == 0 || scores[i - 1].1 < v) && (i + 1 == scores.len() || scores[i + 1].1 <= v)
+        })
+        .map(|i| scores[i].1)
+        .fold(-1.0f32, f32::max);
+    if best < config.min_correlation || runner_up > best - GUIDED_PEAK_MARGIN {
+        return None;
+    }
+    refine_pair(
+        left_plane,
+        right_plane,
+        [lx as f32, ly as f32],
+        [(gx + best_dx) as f32, gy as f32],
+        config,
+    )
+}
+
+/// A guided match's correlation peak must beat any other peak by this much (ambiguity test,
+/// the analogue of the descriptor ratio test).
+const GUIDED_PEAK_MARGIN: f32 = 0.1;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -236,6 +335,23 @@ mod tests {
         }
         // Quantisation to u8 limits the precision; a few hundredths of a pixel remain.
         assert!(worst < 0.05, "worst error {worst} px");
+    }
+
+    #[test]
+    fn guided_search_finds_a_shift_beyond_the_lucas_kanade_basin() {
+        let l = plane(100, 60, 0.0, 0.0, 1.0);
+        let r = plane(100, 60, -6.4, 0.3, 1.0);
+        let got = guided_pair(
+            &l,
+            &r,
+            [50.0, 30.0],
+            [47.0, 30.0],
+            8,
+            &SubpixelConfig::default(),
+        )
+        .unwrap();
+        assert!((got.right[0] - (got.left[0] - 6.4)).abs() < 0.05, "{got:?}");
+        assert!((got.right[1] - (got.left[1] + 0.3)).abs() < 0.05, "{got:?}");
     }
 
     #[test]

@@ -283,6 +283,27 @@ fn injected_verge_on_street_pairs() {
             }
         }
         all_errors.extend(errors.iter().map(|e| e.map(|v| v - s.residual)));
+        // The same moving sequence through the Kalman filter (30 fps timestamps).
+        let mut filter = VergeFilter::new(KalmanConfig::default());
+        let filtered: Vec<Option<f64>> = results
+            .iter()
+            .enumerate()
+            .map(|(i, (truth, e))| {
+                let m = e.as_ref().map(|e| Measurement {
+                    verge_deg: e.verge_deg - s.residual,
+                    sigma_deg: e.sigma_deg,
+                });
+                let o = filter
+                    .step(i as u64 * 33_333, m)
+                    .expect("time runs forward");
+                o.map(|o| o.verge_deg - truth.to_degrees())
+            })
+            .collect();
+        let fstats = stats(&filtered, &[]);
+        println!(
+            "{:<10} moving, filtered: |err| median {:.4}° max {:.4}° (residual {:+.4}°)",
+            scene.name, fstats.median, fstats.max, fstats.residual
+        );
 
         // Fixed cameras: constant verge 1.5°, the head's common yaw varies (the view changes).
         let fixed: Vec<Option<FrameEstimate>> = (0..FRAMES)
