@@ -6,7 +6,9 @@ mod driver_fixture;
 use std::time::Duration;
 
 use driver_fixture::{frame_packets, pattern, point, FrameSpec, Sobel, Wire};
-use stereocal::driver::{ContentError, Damage, Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame};
+use stereocal::driver::{
+    ContentError, Damage, Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame,
+};
 use stereocal::frame::Gradients;
 use stereocal::link::{LinkError, ReplayLink};
 use stereocal_wire::{Camera, PacketKind};
@@ -20,7 +22,9 @@ fn driver(wire: &Wire) -> Driver<ReplayLink> {
 fn delivered(outcome: FrameOutcome) -> ReceivedFrame {
     match outcome {
         FrameOutcome::Delivered(f) => *f,
-        FrameOutcome::Damaged(d) => panic!("frame {} {:?} damaged: {}", d.frame_id, d.camera, d.damage),
+        FrameOutcome::Damaged(d) => {
+            panic!("frame {} {:?} damaged: {}", d.frame_id, d.camera, d.damage)
+        }
     }
 }
 
@@ -114,10 +118,16 @@ fn patches_are_matched_to_points_and_points_without_patch_are_dropped() {
     assert_eq!(patches.len(), 2);
     // Window offset (dx, dy) of keypoint 1 is octave pixel (2 + dx, 2 + dy).
     let px = pattern(0, 3, 1);
-    assert_eq!(f.features.window_sample(1, 1, -1), Some((px.magnitude, px.orientation)));
+    assert_eq!(
+        f.features.window_sample(1, 1, -1),
+        Some((px.magnitude, px.orientation))
+    );
     assert_eq!(f.features.window_sample(1, -3, 0), Some((0, 0)));
     let px = pattern(0, 5, 6);
-    assert_eq!(f.features.window_sample(0, 0, 0), Some((px.magnitude, px.orientation)));
+    assert_eq!(
+        f.features.window_sample(0, 0, 0),
+        Some((px.magnitude, px.orientation))
+    );
 }
 
 #[test]
@@ -216,7 +226,10 @@ fn frame_cut_short_by_the_next_frame_start_is_damaged() {
     let first = d.next_frame(T).unwrap();
     match damage(first) {
         Damage::Truncated { next } => {
-            assert_eq!((next.kind, next.seq, next.frame_id), (PacketKind::FrameStart, next_seq, 3))
+            assert_eq!(
+                (next.kind, next.seq, next.frame_id),
+                (PacketKind::FrameStart, next_seq, 3)
+            )
         }
         other => panic!("truncation expected, got {other}"),
     }
@@ -233,7 +246,10 @@ fn bytes_cut_off_mid_packet_damage_the_frame() {
     bytes.extend_from_slice(&next.bytes);
     let mut d = Driver::new(ReplayLink::new(bytes));
     // The cut FrameEnd merges with the next FrameStart into one undecodable link frame.
-    assert!(matches!(damage(d.next_frame(T).unwrap()), Damage::Undecodable { .. }));
+    assert!(matches!(
+        damage(d.next_frame(T).unwrap()),
+        Damage::Undecodable { .. }
+    ));
     // The next frame's numbering restarted at 0 (another device run); it is then missing
     // its start and is dropped too, without the driver getting stuck.
     let second = d.next_frame(T).unwrap();
@@ -255,10 +271,16 @@ fn log_packets_inside_a_frame_are_surfaced_not_damage() {
     }
     let mut d = driver(&wire);
     let f = delivered(d.next_frame(T).unwrap());
-    assert_eq!(f.wire_bytes, frame_bytes as u64, "log bytes are not the frame's");
+    assert_eq!(
+        f.wire_bytes, frame_bytes as u64,
+        "log bytes are not the frame's"
+    );
     let logs = d.take_logs();
     assert_eq!(logs.len(), 1);
-    assert_eq!((logs[0].seq, &logs[0].bytes[..]), (2, &[0x01, 0x00, 0x2a, 0x00][..]));
+    assert_eq!(
+        (logs[0].seq, &logs[0].bytes[..]),
+        (2, &[0x01, 0x00, 0x2a, 0x00][..])
+    );
     assert!(d.take_logs().is_empty());
     assert_eq!(d.stats().log_frames, 1);
 }
@@ -324,10 +346,15 @@ fn a_packet_of_another_frame_damages_both() {
     }
     wire.frame(&FrameSpec::small(10, Camera::Left));
     let mut d = driver(&wire);
-    assert!(matches!(damage(d.next_frame(T).unwrap()), Damage::Foreign { packet } if packet.camera == Camera::Right));
+    assert!(
+        matches!(damage(d.next_frame(T).unwrap()), Damage::Foreign { packet } if packet.camera == Camera::Right)
+    );
     let second = d.next_frame(T).unwrap();
     assert_eq!((second.frame_id(), second.camera()), (9, Camera::Right));
-    assert!(matches!(damage(second), Damage::Foreign { .. } | Damage::MissingStart { .. }));
+    assert!(matches!(
+        damage(second),
+        Damage::Foreign { .. } | Damage::MissingStart { .. }
+    ));
     assert_eq!(delivered(d.next_frame(T).unwrap()).frame_id, 10);
     assert_eq!(d.stats().frames_damaged, 2);
 }

@@ -19,7 +19,10 @@ const SHORT: Duration = Duration::from_millis(50);
 /// (unless the test writes to it).
 fn silent_device() -> (Driver<StreamLink<UnixStream>>, UnixStream) {
     let (host, device) = UnixStream::pair().unwrap();
-    (Driver::new(StreamLink::from_stream(host, "unix pair")), device)
+    (
+        Driver::new(StreamLink::from_stream(host, "unix pair")),
+        device,
+    )
 }
 
 #[test]
@@ -58,7 +61,9 @@ fn hello_times_out_naming_the_hello() {
 #[test]
 fn register_read_times_out_naming_the_register() {
     let (mut driver, _device) = silent_device();
-    let err = driver.read_register(regs::width::OFFSET, SHORT).unwrap_err();
+    let err = driver
+        .read_register(regs::width::OFFSET, SHORT)
+        .unwrap_err();
     assert!(matches!(
         err,
         DriverError::Timeout {
@@ -113,6 +118,10 @@ fn frame_wait_times_out_naming_the_frame_in_progress() {
         rest.push(&p.repr());
     }
     device.write_all(&rest.bytes).unwrap();
-    let frame = driver.next_frame(SHORT).unwrap().delivered().expect("delivered");
+    let frame = driver
+        .next_frame(SHORT)
+        .unwrap()
+        .delivered()
+        .expect("delivered");
     assert_eq!(frame.frame_id, 12);
 }

@@ -19,7 +19,12 @@ const T: Duration = Duration::from_secs(5);
 
 fn frames() -> Vec<FrameSpec> {
     (1..=2)
-        .flat_map(|id| [FrameSpec::small(id, Camera::Left), FrameSpec::small(id, Camera::Right)])
+        .flat_map(|id| {
+            [
+                FrameSpec::small(id, Camera::Left),
+                FrameSpec::small(id, Camera::Right),
+            ]
+        })
         .collect()
 }
 
@@ -37,7 +42,9 @@ fn session(link: impl Link) {
         sobel_output: SobelOutput::Rows,
         sobel_scale: 1,
     };
-    driver.configure(&config, T).expect("configuration reads back");
+    driver
+        .configure(&config, T)
+        .expect("configuration reads back");
     driver.enable().expect("enable");
     for id in 1..=2 {
         match driver.next_pair(T).expect("pair") {
@@ -52,7 +59,10 @@ fn session(link: impl Link) {
         }
     }
     let s = driver.stats();
-    assert_eq!((s.frames_delivered, s.frames_damaged, s.undecodable), (4, 0, 0));
+    assert_eq!(
+        (s.frames_delivered, s.frames_damaged, s.undecodable),
+        (4, 0, 0)
+    );
     assert!(s.bytes_sent > 0 && s.bytes_received > 4 * s.mean_frame_bytes() as u64);
 }
 
@@ -105,9 +115,17 @@ fn connecting_to_nothing_names_the_link() {
     let addr = listener.local_addr().unwrap();
     drop(listener);
     let err = TcpLink::tcp(&addr.to_string()).unwrap_err();
-    assert!(err.to_string().starts_with(&format!("tcp {addr}: cannot open")), "{err}");
+    assert!(
+        err.to_string()
+            .starts_with(&format!("tcp {addr}: cannot open")),
+        "{err}"
+    );
     let err = StreamLink::serial("/dev/stereocal-no-such-port", 115_200).unwrap_err();
-    assert!(err.to_string().contains("serial /dev/stereocal-no-such-port"), "{err}");
+    assert!(
+        err.to_string()
+            .contains("serial /dev/stereocal-no-such-port"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -20,8 +20,8 @@ use super::damage::{ContentError, Damage, PacketRef};
 use super::gradients::{FinishError, GradientBuilder};
 use super::keypoint::keypoint;
 use super::stats::LinkStats;
-use stereocal_firmware::fabric::geometry::octave_dims;
 use crate::frame::{FeatureFrame, Keypoint};
+use stereocal_firmware::fabric::geometry::octave_dims;
 
 /// A camera frame that arrived complete and consistent.
 #[derive(Debug, Clone, PartialEq)]
@@ -415,12 +415,13 @@ impl FrameAssembler {
         let damage = p.damage.clone().unwrap_or(damage);
         self.stats.frames_damaged += 1;
         self.stats.damage.count(&damage);
-        self.events.push_back(Event::Frame(FrameOutcome::Damaged(DamagedFrame {
-            frame_id: p.frame_id,
-            camera: p.camera,
-            damage,
-            wire_bytes: p.wire_bytes,
-        })));
+        self.events
+            .push_back(Event::Frame(FrameOutcome::Damaged(DamagedFrame {
+                frame_id: p.frame_id,
+                camera: p.camera,
+                damage,
+                wire_bytes: p.wire_bytes,
+            })));
     }
 
     /// Closes a frame at its `FrameEnd` (sequence number `seq`).
@@ -491,17 +492,19 @@ impl FrameAssembler {
         self.stats.frames_delivered += 1;
         self.stats.delivered_wire_bytes += p.wire_bytes;
         self.events
-            .push_back(Event::Frame(FrameOutcome::Delivered(Box::new(ReceivedFrame {
-                frame_id: p.frame_id,
-                camera: p.camera,
-                features,
-                octaves: start.octaves,
-                wire_bytes: p.wire_bytes,
-                packets: p.packets,
-                dropped_points: end.dropped_points,
-                dropped_sobel: end.dropped_sobel,
-                flags: end.flags,
-                points_without_patch: finished.without_patch,
-            }))));
+            .push_back(Event::Frame(FrameOutcome::Delivered(Box::new(
+                ReceivedFrame {
+                    frame_id: p.frame_id,
+                    camera: p.camera,
+                    features,
+                    octaves: start.octaves,
+                    wire_bytes: p.wire_bytes,
+                    packets: p.packets,
+                    dropped_points: end.dropped_points,
+                    dropped_sobel: end.dropped_sobel,
+                    flags: end.flags,
+                    points_without_patch: finished.without_patch,
+                },
+            ))));
     }
 }

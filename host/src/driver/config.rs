@@ -79,7 +79,9 @@ mod tests {
             ]
         );
         assert!(plan.read_back.contains(&(regs::width::OFFSET, 320)));
-        assert!(plan.read_back.contains(&(regs::output_mode::OFFSET, 2 << 4)));
+        assert!(plan
+            .read_back
+            .contains(&(regs::output_mode::OFFSET, 2 << 4)));
     }
 
     #[test]
@@ -88,6 +90,9 @@ mod tests {
             width: 322,
             ..FabricConfig::default()
         };
-        assert!(matches!(plan(&config), Err(Error::FrameNotDivisible { .. })));
+        assert!(matches!(
+            plan(&config),
+            Err(Error::FrameNotDivisible { .. })
+        ));
     }
 }

@@ -135,7 +135,11 @@ impl GradientBuilder {
     }
 
     /// Adds one `SobelPatch` packet of a frame with `octaves` octaves.
-    pub fn add_patch(&mut self, patch: &SobelPatchRepr<'_>, octaves: u8) -> Result<(), ContentError> {
+    pub fn add_patch(
+        &mut self,
+        patch: &SobelPatchRepr<'_>,
+        octaves: u8,
+    ) -> Result<(), ContentError> {
         if patch.octave >= octaves {
             return Err(ContentError::Octave {
                 octave: patch.octave,
@@ -175,7 +179,11 @@ impl GradientBuilder {
     }
 
     /// Pairs the gradients with the frame's points.
-    pub fn finish(self, points: &[Point], keypoints: Vec<Keypoint>) -> Result<Finished, FinishError> {
+    pub fn finish(
+        self,
+        points: &[Point],
+        keypoints: Vec<Keypoint>,
+    ) -> Result<Finished, FinishError> {
         match self {
             Self::Empty => Ok(Finished {
                 keypoints,

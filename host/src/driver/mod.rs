@@ -206,7 +206,10 @@ impl<L: Link> Driver<L> {
 
     /// Writes one register (no answer expected).
     pub fn write_register(&mut self, addr: u16, value: u32) -> Result<(), DriverError> {
-        self.send(&PacketRepr::RegisterWrite(RegisterWriteRepr { addr, value }))
+        self.send(&PacketRepr::RegisterWrite(RegisterWriteRepr {
+            addr,
+            value,
+        }))
     }
 
     /// Reads one register.
@@ -235,7 +238,11 @@ impl<L: Link> Driver<L> {
 
     /// Writes the fabric configuration (width, height, octaves, thresholds, output mode)
     /// and reads every written register back. Nothing is sent when `config` is invalid.
-    pub fn configure(&mut self, config: &FabricConfig, timeout: Duration) -> Result<(), DriverError> {
+    pub fn configure(
+        &mut self,
+        config: &FabricConfig,
+        timeout: Duration,
+    ) -> Result<(), DriverError> {
         let plan = config::plan(config).map_err(DriverError::Config)?;
         for &(addr, value) in &plan.writes {
             self.write_register(addr, value)?;
@@ -313,7 +320,12 @@ impl<L: Link> Driver<L> {
 
     /// Decodes buffered bytes, or receives more, until at least one event was sorted into
     /// its queue.
-    fn pump(&mut self, deadline: Instant, timeout: Duration, waiting: Waiting) -> Result<(), DriverError> {
+    fn pump(
+        &mut self,
+        deadline: Instant,
+        timeout: Duration,
+        waiting: Waiting,
+    ) -> Result<(), DriverError> {
         loop {
             if self.decode_buffered() {
                 return Ok(());

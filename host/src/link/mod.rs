@@ -15,6 +15,7 @@
 //! | a byte capture played back | [`ReplayLink`] | [`ReplayLink::new`], [`ReplayLink::from_file`] |
 
 mod error;
+mod in_process;
 mod replay;
 mod serial;
 mod stream;
@@ -25,12 +26,13 @@ mod unix;
 use std::time::Instant;
 
 pub use error::LinkError;
+pub use in_process::InProcessLink;
 pub use replay::ReplayLink;
 pub use serial::SerialLink;
+pub use stream::{StreamLink, TimedStream};
 pub use tcp::TcpLink;
 #[cfg(unix)]
 pub use unix::UnixLink;
-pub use stream::{StreamLink, TimedStream};
 
 /// A bidirectional byte pipe to the device.
 ///

@@ -5,8 +5,8 @@ use std::io::{ErrorKind, Read, Write};
 
 use stereocal_hdl::{regs, RegisterBank, RegisterBus};
 use stereocal_wire::{
-    Accumulator, Capabilities, FeedResult, HelloRepr, PacketRepr, RegisterValueRepr,
-    MAX_FRAME_LEN, PROTOCOL_VERSION,
+    Accumulator, Capabilities, FeedResult, HelloRepr, PacketRepr, RegisterValueRepr, MAX_FRAME_LEN,
+    PROTOCOL_VERSION,
 };
 
 use super::{FrameSpec, Wire};
@@ -23,7 +23,14 @@ pub fn serve(stream: &mut (impl Read + Write), frames: &[FrameSpec]) -> usize {
         let n = match stream.read(&mut buf) {
             Ok(0) => return received,
             Ok(n) => n,
-            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted) => continue,
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
+                ) =>
+            {
+                continue
+            }
             Err(_) => return received,
         };
         let mut window = &buf[..n];

@@ -10,8 +10,8 @@ use std::ops::Range;
 use stereocal_firmware::fabric::geometry::octave_dims;
 use stereocal_wire::{
     encode, Camera, FrameEndFlags, FrameEndRepr, FrameStartRepr, LogRepr, PacketRepr, Point,
-    PointBatchRepr, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, MAX_FRAME_LEN,
-    MAX_POINTS, PATCH_PIXELS,
+    PointBatchRepr, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, MAX_FRAME_LEN, MAX_POINTS,
+    PATCH_PIXELS,
 };
 
 /// The Sobel pixel the fixture sends at octave pixel `(x, y)` of `octave`.

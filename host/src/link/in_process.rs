@@ -1,0 +1,191 @@
+//! The device inside the host: the firmware's soft-core driver and fabric model, one channel
+//! per camera, called synchronously.
+//!
+//! This is the default link of `stereocal run/eval/demo`: the same firmware code as the ELF,
+//! the same wire bytes as QEMU or a board, without a process or a socket in between. Images
+//! go in through [`InProcessLink::submit_pair`]; the driver's packets collect in an outbox
+//! that [`Link::recv`] hands out. The fabric runs its fast path unless
+//! [`InProcessLink::register_level`] asks for the clock-level model.
+//!
+//! Register writes from the host go to both channels (the head's two fabrics are configured
+//! alike); `Hello` and register reads are answered by the left channel, so each request gets
+//! one answer, as from a single device.
+
+use std::time::Instant;
+
+use stereocal_firmware::driver::{
+    ByteSink, Driver as Channel, DriverError as ChannelError, FabricModel, FrameSummary,
+    PacketWriter,
+};
+use stereocal_hdl::RegisterBank;
+use stereocal_wire::{Accumulator, Camera, FeedResult, PacketRepr, MAX_FRAME_LEN};
+
+use super::{Link, LinkError};
+
+/// Name in errors.
+const NAME: &str = "in-process";
+
+/// One camera's channel at the fabric's full size (1280-pixel lines).
+type FullChannel = Channel<RegisterBank, FabricModel, 1280>;
+
+/// The device's output, waiting for the host to read it.
+#[derive(Debug, Default)]
+struct Outbox {
+    bytes: Vec<u8>,
+    read: usize,
+}
+
+impl ByteSink for Outbox {
+    fn write(&mut self, bytes: &[u8]) {
+        self.bytes.extend_from_slice(bytes);
+    }
+}
+
+/// The fabric model and the soft-core driver of both cameras, in this process.
+pub struct InProcessLink {
+    left: Box<FullChannel>,
+    right: Box<FullChannel>,
+    writer: PacketWriter<Outbox>,
+    inbox: Box<Accumulator<{ MAX_FRAME_LEN - 1 }>>,
+}
+
+impl InProcessLink {
+    /// Both channels on the fabric's fast path (bit-exact with the register-level model).
+    pub fn new() -> Result<Self, LinkError> {
+        Self::with_model(FabricModel::fast)
+    }
+
+    /// Both channels on the register-level model (one clock per pixel; much slower).
+    pub fn register_level() -> Result<Self, LinkError> {
+        Self::with_model(FabricModel::register_level)
+    }
+
+    fn with_model(model: fn() -> FabricModel) -> Result<Self, LinkError> {
+        Ok(Self {
+            left: boxed_channel(Camera::Left, model)?,
+            right: boxed_channel(Camera::Right, model)?,
+            writer: PacketWriter::new(Outbox::default()),
+            inbox: Box::new(Accumulator::new()),
+        })
+    }
+
+    /// Runs one camera's image (raster order, 8-bit grey, the configured size) through its
+    /// channel; the frame's packets wait in the outbox.
+    pub fn submit(
+        &mut self,
+        camera: Camera,
+        image: &[u8],
+        timestamp_us: u64,
+    ) -> Result<FrameSummary, LinkError> {
+        let channel = match camera {
+            Camera::Left => &mut self.left,
+            Camera::Right => &mut self.right,
+            Camera::Unknown(c) => {
+                return Err(LinkError::Device(format!("no camera channel {c}")));
+            }
+        };
+        channel
+            .process_frame(image, timestamp_us, &mut self.writer)
+            .map_err(|e| channel_error(camera, &e))
+    }
+
+    /// Runs a stereo pair, left first: the frame's packets of both cameras wait in the
+    /// outbox, the two frames carry the same frame id.
+    pub fn submit_pair(
+        &mut self,
+        left: &[u8],
+        right: &[u8],
+        timestamp_us: u64,
+    ) -> Result<[FrameSummary; 2], LinkError> {
+        Ok([
+            self.submit(Camera::Left, left, timestamp_us)?,
+            self.submit(Camera::Right, right, timestamp_us)?,
+        ])
+    }
+
+    /// Bytes the device sent that the host has not read yet.
+    pub fn pending(&self) -> usize {
+        self.writer.sink().bytes.len() - self.writer.sink().read
+    }
+}
+
+/// Stack of the thread that builds a channel.
+const BUILD_STACK: usize = 16 << 20;
+
+/// Builds a channel on the heap.
+///
+/// A channel is about half a megabyte of fixed arrays (the firmware allocates nothing), and
+/// an unoptimised build moves it through the stack a few times before it lands in the box:
+/// more than a 2 MiB test thread has. A short-lived thread with a roomy stack builds it.
+fn boxed_channel(
+    camera: Camera,
+    model: fn() -> FabricModel,
+) -> Result<Box<FullChannel>, LinkError> {
+    let builder = std::thread::Builder::new()
+        .name("in-process channel".into())
+        .stack_size(BUILD_STACK);
+    let build = move || Box::new(Channel::new(RegisterBank::new(), model(), camera));
+    builder
+        .spawn(build)
+        .map_err(|e| LinkError::Device(format!("cannot start the {camera:?} channel: {e}")))?
+        .join()
+        .map_err(|_| LinkError::Device(format!("building the {camera:?} channel failed")))
+}
+
+fn channel_error(camera: Camera, e: &ChannelError) -> LinkError {
+    LinkError::Device(format!("{camera:?} channel: {e}"))
+}
+
+impl Link for InProcessLink {
+    /// Decodes the host's packets and lets the device answer them at once. Undecodable
+    /// bytes are dropped, as the soft-core's receiver drops them.
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        let mut window = bytes;
+        while !window.is_empty() {
+            let (result, rest) = match self.inbox.feed(window) {
+                FeedResult::Consumed => (Ok(()), &window[window.len()..]),
+                FeedResult::OverFull(rest) => (Ok(()), rest),
+                FeedResult::DecodeError { remaining, .. } => (Ok(()), remaining),
+                FeedResult::Success {
+                    packet, remaining, ..
+                } => {
+                    // Writes go to both channels; the left one answers every request.
+                    if let PacketRepr::RegisterWrite(w) = packet {
+                        self.right.write_register(w.addr, w.value);
+                    }
+                    let answered = self
+                        .left
+                        .handle_host_packet(&packet, &mut self.writer)
+                        .map_err(|e| channel_error(Camera::Left, &e));
+                    (answered, remaining)
+                }
+            };
+            result?;
+            window = rest;
+        }
+        Ok(())
+    }
+
+    /// Hands out what the device sent. The device only runs when it is given work, so an
+    /// empty outbox is a timeout at once: nothing can arrive by waiting.
+    fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
+        let _ = deadline;
+        let outbox = self.writer.sink_mut();
+        let pending = &outbox.bytes[outbox.read..];
+        if pending.is_empty() {
+            return Err(LinkError::Timeout {
+                link: NAME.into(),
+                waited: std::time::Duration::ZERO,
+            });
+        }
+        let n = pending.len().min(buf.len());
+        buf[..n].copy_from_slice(&pending[..n]);
+        outbox.read += n;
+        if outbox.read == outbox.bytes.len() {
+            // Everything read: reuse the allocation for the next frame.
+            outbox.bytes.clear();
+            outbox.read = 0;
+        }
+        Ok(n)
+    }
+}
