@@ -31,7 +31,7 @@ fn plane(seed: u64, shift: i32) -> SobelPlane {
             (
                 rng.random_range(0.05..0.6),
                 rng.random_range(0.05..0.6),
-                rng.random_range(0.0..6.28),
+                rng.random_range(0.0..std::f32::consts::TAU),
                 rng.random_range(10.0..30.0),
             )
         })

@@ -81,8 +81,8 @@ fn features(img: &GrayImage, index: u64, keep: &dyn Fn(f32, f32) -> bool) -> Fea
         &mut *fe,
         &config,
         img.as_raw(),
-        &mut |p| points.push(p),
-        &mut |s| sobel.push(s),
+        &mut |p| points.extend_from_slice(p),
+        &mut |s| sobel.extend_from_slice(s),
     )
     .expect("fabric fast path");
     assert_eq!(
