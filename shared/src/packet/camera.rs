@@ -31,3 +31,16 @@ impl From<Camera> for u8 {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_byte_round_trips() {
+        for byte in 0..=u8::MAX {
+            assert_eq!(u8::from(Camera::from(byte)), byte);
+        }
+        assert_eq!(Camera::from(7), Camera::Unknown(7));
+    }
+}

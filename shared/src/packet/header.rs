@@ -161,3 +161,99 @@ impl Header {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The `register_read` vector of the spec: RegisterRead of 0x0104, seq 3.
+    static PACKET_BYTES: [u8; 12] = [
+        0x01, // version 1
+        0x03, // kind RegisterRead
+        0x03, 0x00, // seq 3
+        0x02, 0x00, // payload_len 2
+        0x04, 0x01, // payload: addr 0x0104
+        0x71, 0xb0, 0x2b, 0x4a, // CRC-32C 0x4a2bb071
+    ];
+
+    const HEADER: Header = Header {
+        version: 1,
+        kind: PacketKind::RegisterRead,
+        seq: 3,
+        payload_len: 2,
+    };
+
+    #[test]
+    fn deconstruct() {
+        let packet = Packet::new_checked(&PACKET_BYTES[..]).unwrap();
+        assert_eq!(packet.version(), 1);
+        assert_eq!(packet.kind(), PacketKind::RegisterRead);
+        assert_eq!(packet.seq(), 3);
+        assert_eq!(packet.payload_len(), 2);
+        assert_eq!(packet.payload(), &[0x04, 0x01]);
+        assert_eq!(packet.crc(), 0x4a2b_b071);
+        assert!(packet.verify_crc());
+    }
+
+    #[test]
+    fn construct() {
+        let mut bytes = [0xa5u8; 12];
+        let mut packet = Packet::new_unchecked(&mut bytes[..]);
+        packet.set_version(1);
+        packet.set_kind(PacketKind::RegisterRead);
+        packet.set_seq(3);
+        packet.set_payload_len(2);
+        packet.payload_mut().copy_from_slice(&[0x04, 0x01]);
+        packet.fill_crc();
+        assert_eq!(bytes, PACKET_BYTES);
+    }
+
+    #[test]
+    fn parse() {
+        let packet = Packet::new_unchecked(&PACKET_BYTES[..]);
+        assert_eq!(Header::parse(&packet), Ok(HEADER));
+        assert_eq!(HEADER.buffer_len(), PACKET_BYTES.len());
+    }
+
+    #[test]
+    fn emit() {
+        let mut bytes = [0u8; 12];
+        let mut packet = Packet::new_unchecked(&mut bytes[..]);
+        HEADER.emit(&mut packet).unwrap();
+        packet.payload_mut().copy_from_slice(&[0x04, 0x01]);
+        packet.fill_crc();
+        assert_eq!(bytes, PACKET_BYTES);
+    }
+
+    #[test]
+    fn corrupted_byte_fails_the_crc() {
+        for at in 0..PACKET_BYTES.len() {
+            let mut bytes = PACKET_BYTES;
+            bytes[at] ^= 0x10;
+            assert!(!Packet::new_unchecked(&bytes[..]).verify_crc(), "byte {at}");
+        }
+    }
+
+    #[test]
+    fn impossible_length() {
+        assert_eq!(
+            Packet::new_checked(&PACKET_BYTES[..9]).unwrap_err(),
+            Error::DecodeUnexpectedEnd
+        );
+        assert_eq!(
+            Packet::new_checked(&PACKET_BYTES[..11]).unwrap_err(),
+            Error::DecodeUnexpectedEnd
+        );
+        let mut long = [0u8; 13];
+        long[..12].copy_from_slice(&PACKET_BYTES);
+        assert_eq!(
+            Packet::new_checked(&long[..]).unwrap_err(),
+            Error::DecodeBadLength
+        );
+        let mut short = [0u8; 11];
+        assert_eq!(
+            HEADER.emit(&mut Packet::new_unchecked(&mut short[..])),
+            Err(Error::EncodeBufferTooSmall)
+        );
+    }
+}
