@@ -1,11 +1,19 @@
 //! The soft-core program (`riscv32imc-unknown-none-elf`, QEMU `virt` machine).
 //!
-//! Boot, say Hello on the UART, then run the frames of the frame-grabber input region through
-//! the fabric and the driver; exit through the `sifive_test` finisher. Build it with
-//! `cargo build --release -p stereocal-firmware --target riscv32imc-unknown-none-elf`.
+//! 1. Boot: check the frame-grabber input region (`softcore::frame_input`), program each
+//!    camera channel's WIDTH/HEIGHT from it, send `Hello`.
+//! 2. Unless the input asks to autostart, answer the host's packets (`Hello`, `RegisterRead`,
+//!    `RegisterWrite`; writes go to every channel, reads are answered from the left one) until
+//!    the host sets `CONTROL.ENABLE`.
+//! 3. For every frame of the input, left then right image: the driver runs the image through
+//!    the fabric model and sends its packets. Host packets waiting between frames are
+//!    answered; clearing `CONTROL.ENABLE` pauses before the next frame.
+//! 4. Exit through the `sifive_test` finisher: 0 when every frame ran, 2 for a bad input
+//!    region, 3 when a frame failed (an `ErrorReport` says why), 101 on a panic.
 //!
-//! On any other target this file builds a stub that says so, so that host builds of the whole
-//! workspace (`cargo build --workspace`, clippy, tests) work without the bare-metal runtime.
+//! Build: `cargo build --release -p stereocal-firmware --target riscv32imc-unknown-none-elf`.
+//! Run: see the `softcore` module of the library (QEMU command line, link protocol). On any other target this file builds a stub that says so,
+//! so host builds of the whole workspace (build, clippy, tests) need no bare-metal runtime.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(not(target_os = "none"))]
@@ -13,43 +21,194 @@ fn main() {
     eprintln!(
         "stereocal-firmware is the soft-core program; build it for the soft-core with\n  \
          cargo build --release -p stereocal-firmware --target riscv32imc-unknown-none-elf\n\
-         and run the ELF under qemu-system-riscv32 -machine virt (see firmware/README.md)."
+         and run the ELF under qemu-system-riscv32 -machine virt (see the docs of\n\
+         stereocal_firmware::softcore)."
     );
     std::process::exit(2);
 }
 
 #[cfg(target_os = "none")]
 mod soft_core {
-    use stereocal_firmware::driver::PacketWriter;
+    use stereocal_firmware::driver::{Driver, DriverError, FabricModel, PacketWriter};
     use stereocal_firmware::softcore::finisher::{self, ExitCode};
     use stereocal_firmware::softcore::frame_input::{
-        FrameInput, VIRT_FRAME_REGION, VIRT_FRAME_REGION_LEN,
+        FrameInput, InputHeader, FLAG_AUTOSTART, FLAG_REGISTER_MODEL, VIRT_FRAME_REGION,
+        VIRT_FRAME_REGION_LEN,
     };
     use stereocal_firmware::softcore::link::{Uart0, LINK};
-    use stereocal_wire::{Capabilities, HelloRepr, PacketRepr, PROTOCOL_VERSION};
+    use stereocal_hdl::regs::{control, height, width};
+    use stereocal_hdl::{RegisterBank, RegisterBus};
+    use stereocal_wire::{
+        Accumulator, Camera, Capabilities, ErrorCode, ErrorReportRepr, FeedResult, HelloRepr,
+        PacketRepr, PROTOCOL_VERSION,
+    };
+
+    /// One camera channel: the model's registers, the model, the driver.
+    type Channel = Driver<RegisterBank, FabricModel>;
+
+    /// Host packets are short (a RegisterWrite is 16 framed bytes); a longer frame is refused.
+    type HostAccumulator = Accumulator<64>;
+
+    /// Sends a packet through the shared link writer.
+    fn send(packet: &PacketRepr<'_>) {
+        critical_section::with(|cs| {
+            // Every packet built here is within the wire limits; a failure would be a bug
+            // that the host sees as a missing packet.
+            let _ = LINK.borrow_ref_mut(cs).send(packet);
+        });
+    }
+
+    fn report(code: ErrorCode, detail: u32) {
+        send(&PacketRepr::ErrorReport(ErrorReportRepr { code, detail }));
+    }
+
+    /// Runs `f` with the link writer borrowed.
+    fn with_link<R>(f: impl FnOnce(&mut PacketWriter<Uart0>) -> R) -> R {
+        critical_section::with(|cs| f(&mut LINK.borrow_ref_mut(cs)))
+    }
+
+    fn stop(code: ExitCode) -> ! {
+        // SAFETY: this program only runs on QEMU `virt`, which has the finisher.
+        unsafe { finisher::exit(code) }
+    }
+
+    /// A channel for `camera` whose WIDTH/HEIGHT match the input frames.
+    fn channel(header: &InputHeader, camera: Camera) -> Channel {
+        let model = if header.has_flag(FLAG_REGISTER_MODEL) {
+            FabricModel::register_level()
+        } else {
+            FabricModel::fast()
+        };
+        let mut channel =
+            Driver::new(RegisterBank::new(), model, camera).with_capabilities(Capabilities::LOG);
+        let bus = channel.bus_mut();
+        let geometry = bus
+            .write_field(&width::VALUE, header.width.into())
+            .and_then(|()| bus.write_field(&height::VALUE, header.height.into()));
+        if let Err(e) = geometry {
+            defmt::error!("input frames: {}", defmt::Display2Format(&e));
+            report(
+                ErrorCode::Unknown(stereocal_firmware::driver::ERROR_INVALID_CONFIG),
+                width::OFFSET.into(),
+            );
+            stop(ExitCode::BadInput);
+        }
+        if header.has_flag(FLAG_AUTOSTART) {
+            channel.write_register(control::OFFSET, control::ENABLE.mask());
+        }
+        channel
+    }
+
+    /// Answers every host packet received so far; with `wait`, also waits for more packets
+    /// while CONTROL.ENABLE is 0.
+    fn serve_host(
+        acc: &mut HostAccumulator,
+        channels: &mut [Channel],
+        last_good_seq: &mut u16,
+        wait: bool,
+    ) {
+        loop {
+            let byte = match Uart0::device().try_read_byte() {
+                Some(byte) => byte,
+                None if wait && channels[0].bus_mut().read_field(&control::ENABLE) == 0 => {
+                    core::hint::spin_loop();
+                    continue;
+                }
+                None => return,
+            };
+            match acc.feed(&[byte]) {
+                FeedResult::Consumed => {}
+                FeedResult::OverFull(_) => report(ErrorCode::BadPacket, (*last_good_seq).into()),
+                FeedResult::DecodeError { .. } => {
+                    report(ErrorCode::BadPacket, (*last_good_seq).into())
+                }
+                FeedResult::Success { header, packet, .. } => {
+                    *last_good_seq = header.seq;
+                    if let PacketRepr::RegisterWrite(w) = packet {
+                        for other in channels.iter_mut().skip(1) {
+                            other.write_register(w.addr, w.value);
+                        }
+                    }
+                    let answered = with_link(|link| channels[0].handle_host_packet(&packet, link));
+                    if let Err(e) = answered {
+                        let (code, detail) = e.report();
+                        report(code, detail);
+                    }
+                }
+            }
+        }
+    }
 
     #[riscv_rt::entry]
     fn main() -> ! {
         Uart0::device().init();
-        let hello = PacketRepr::Hello(HelloRepr {
-            version: PROTOCOL_VERSION,
-            capabilities: Capabilities::POINTS | Capabilities::LOG,
-        });
-        critical_section::with(|cs| {
-            let _ = LINK.borrow_ref_mut(cs).send(&hello);
-        });
-        // SAFETY: the region is RAM that nothing else writes while the firmware runs.
+        // SAFETY: the region is RAM above the program (memory.x) that nothing writes while the
+        // firmware runs; QEMU's loader filled it before the hart started.
         let region = unsafe {
             core::slice::from_raw_parts(VIRT_FRAME_REGION as *const u8, VIRT_FRAME_REGION_LEN)
         };
-        match FrameInput::new(region) {
-            Ok(input) => defmt::error!("frames: {=u32}", input.header().frame_count),
+        let input = match FrameInput::new(region) {
+            Ok(input) => input,
             Err(e) => {
+                send(&hello());
                 defmt::error!("{}", defmt::Display2Format(&e));
-                unsafe { finisher::exit(ExitCode::BadInput) }
+                stop(ExitCode::BadInput);
+            }
+        };
+        let header = *input.header();
+        let mut channels = [
+            channel(&header, Camera::Left),
+            channel(&header, Camera::Right),
+        ];
+        let channels = &mut channels[..usize::from(header.cameras)];
+        send(&hello());
+
+        let mut acc = HostAccumulator::new();
+        let mut last_good_seq = 0;
+        let mut failed = false;
+        for frame in 0..header.frame_count {
+            serve_host(&mut acc, channels, &mut last_good_seq, true);
+            for (camera, channel) in channels.iter_mut().enumerate() {
+                let Some(image) = input.image(frame, camera as u8) else {
+                    // `FrameInput::new` checked that every image is in the region.
+                    stop(ExitCode::BadInput);
+                };
+                let start = riscv::register::minstret::read64();
+                let result =
+                    with_link(|link| channel.process_frame(image.pixels, image.timestamp_us, link));
+                let instructions = riscv::register::minstret::read64().wrapping_sub(start);
+                match result {
+                    Ok(summary) => defmt::info!(
+                        "frame {=u32} camera {=u8}: {=u32} points, {=u64} instructions",
+                        summary.frame_id,
+                        camera as u8,
+                        summary.points,
+                        instructions
+                    ),
+                    Err(e) => {
+                        failed = true;
+                        report_frame_error(&e);
+                    }
+                }
             }
         }
-        let _ = PacketWriter::new(Uart0);
-        unsafe { finisher::exit(ExitCode::Success) }
+        stop(if failed {
+            ExitCode::FrameFailed
+        } else {
+            ExitCode::Success
+        })
+    }
+
+    fn report_frame_error(e: &DriverError) {
+        let (code, detail) = e.report();
+        report(code, detail);
+        defmt::error!("frame failed: {}", defmt::Display2Format(e));
+    }
+
+    fn hello() -> PacketRepr<'static> {
+        PacketRepr::Hello(HelloRepr {
+            version: PROTOCOL_VERSION,
+            capabilities: stereocal_firmware::driver::CHANNEL_CAPABILITIES | Capabilities::LOG,
+        })
     }
 }

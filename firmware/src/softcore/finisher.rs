@@ -22,8 +22,8 @@ pub enum ExitCode {
     Panic = 101,
     /// The frame-grabber input region did not hold a valid header or enough pixels.
     BadInput = 2,
-    /// The host sent something the firmware could not act on and the run cannot continue.
-    LinkError = 3,
+    /// At least one frame could not be processed (an `ErrorReport` on the link says why).
+    FrameFailed = 3,
 }
 
 impl ExitCode {

@@ -5,6 +5,29 @@
 //! `uart`, `finisher` and `frame_input` build everywhere (the host writes frame-input files
 //! with [`frame_input::InputHeader::emit`] and tests the parser); the rest only exists on
 //! `target_os = "none"`, where it is linked into the ELF.
+//!
+//! # Running the ELF under QEMU
+//! ```text
+//! cargo build --release -p stereocal-firmware --target riscv32imc-unknown-none-elf
+//! qemu-system-riscv32 -machine virt -bios none \
+//!     -kernel target/riscv32imc-unknown-none-elf/release/stereocal-firmware \
+//!     -display none -monitor none \
+//!     -chardev socket,id=link,path=/tmp/stereocal.sock,server=on,wait=on -serial chardev:link \
+//!     -device loader,file=frames.bin,addr=0x81000000
+//! ```
+//! The UART is the link, raw bytes both ways: use a socket, `stdio` (with `signal=off`) or a
+//! `file:` chardev, never `-nographic` (its monitor multiplexer eats `0x01` bytes).
+//! `frames.bin` is the frame-grabber input ([`frame_input`]). The firmware sends `Hello`,
+//! then answers `Hello` / `RegisterRead` / `RegisterWrite` until the host writes
+//! `CONTROL.ENABLE = 1` (or at once if the input has [`frame_input::FLAG_AUTOSTART`]), then
+//! sends every frame's packets and exits: status 0 when every frame ran, 2 for a bad input
+//! region, 3 when a frame failed (an `ErrorReport` said why), 101 on a panic (a defmt `Log`
+//! packet carries the message). The host may send more packets between frames; they are read
+//! when the current frame is done (QEMU holds them back meanwhile; a real UART would need the
+//! host to wait for `FrameEnd`).
+//!
+//! Instructions per frame: build with `DEFMT_LOG=info` and run with `-icount shift=0`; each
+//! frame then logs its `minstret` delta (which counts instructions under `-icount`).
 
 pub mod finisher;
 pub mod frame_input;

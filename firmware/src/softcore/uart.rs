@@ -2,7 +2,7 @@
 //!
 //! On the QEMU `virt` machine the UART sits at [`VIRT_UART0`]; QEMU's model needs no baud-rate or
 //! FIFO setup, and a real 16550 behind the same registers only needs [`Ns16550::init`] for the
-//! line format. Everything is polled: the firmware has one job at a time and never enables
+//! line format (its divisor latch is the bitstream's default). Everything is polled: the firmware has one job at a time and never enables
 //! interrupts, so a busy-wait on the line status register is the simplest correct design.
 
 use core::ptr;
@@ -14,8 +14,6 @@ pub const VIRT_UART0: usize = 0x1000_0000;
 const RBR_THR: usize = 0;
 /// Interrupt enable register.
 const IER: usize = 1;
-/// FIFO control register (write).
-const FCR: usize = 2;
 /// Line control register.
 const LCR: usize = 3;
 /// Line status register.
@@ -27,8 +25,6 @@ const LSR_DATA_READY: u8 = 1 << 0;
 const LSR_THR_EMPTY: u8 = 1 << 5;
 /// LCR: 8 data bits, no parity, one stop bit.
 const LCR_8N1: u8 = 0b0000_0011;
-/// FCR: enable and clear both FIFOs.
-const FCR_ENABLE_CLEAR: u8 = 0b0000_0111;
 
 /// One NS16550 UART, addressed through byte-wide registers.
 pub struct Ns16550 {
@@ -57,11 +53,13 @@ impl Ns16550 {
         unsafe { ptr::write_volatile(self.base.add(offset), value) }
     }
 
-    /// Sets 8N1 framing, enables the FIFOs and masks every UART interrupt.
+    /// Sets 8N1 framing and masks every UART interrupt.
+    ///
+    /// The FIFO control register is left alone: changing its enable bit empties the receive
+    /// FIFO, which would lose bytes the host sent before the firmware booted.
     pub fn init(&mut self) {
         self.write_reg(IER, 0);
         self.write_reg(LCR, LCR_8N1);
-        self.write_reg(FCR, FCR_ENABLE_CLEAR);
     }
 
     /// Sends one byte, waiting until the transmitter can take it.
