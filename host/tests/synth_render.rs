@@ -44,7 +44,8 @@ fn project(
 ) -> [f64; 2] {
     let (st, ct) = truth.tilt_deg.to_radians().sin_cos();
     let (sa, ca) = alpha_deg.to_radians().sin_cos();
-    let head = Matrix3::new(1.0, 0.0, 0.0, 0.0, ct, -st, 0.0, st, ct);
+    // Pitch down: the optical axis (0, 0, 1) turns to (0, sin, cos), toward +y (down).
+    let head = Matrix3::new(1.0, 0.0, 0.0, 0.0, ct, st, 0.0, -st, ct);
     let yaw = Matrix3::new(ca, 0.0, sa, 0.0, 1.0, 0.0, -sa, 0.0, ca);
     let c = (head * yaw).transpose() * (p - center);
     [k.fx * c.x / c.z + k.cx, k.fy * c.y / c.z + k.cy]
@@ -249,6 +250,9 @@ fn toe_in_moves_far_points_left_in_left_and_right_in_right() {
             (got[0] - want[0]).abs() < 0.05,
             "side {side}: {got:?} vs {want:?}"
         );
+        // The head is tilted 3° down: a point ahead at eye height appears above the centre.
+        let above = ks[side].cy - 0.9 * ks[side].fy * 3f64.to_radians().tan();
+        assert!(got[1] < above, "side {side}: {got:?}");
         centroids.push(got[0] - ks[side].cx);
     }
     // alpha_l = +7°: the left camera looks right of the point, which appears left of centre;

@@ -99,7 +99,7 @@ pub(crate) fn yaw(angle_rad: f64) -> Matrix3<f64> {
 /// Rotation about the x (right) axis: positive angles turn +z toward +y (down).
 pub(crate) fn pitch_down(angle_rad: f64) -> Matrix3<f64> {
     let (s, c) = angle_rad.sin_cos();
-    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, s, 0.0, -s, c)
 }
 
 #[cfg(test)]

@@ -195,7 +195,9 @@ fn x_box(side: f64, x0: f64, x1: f64, top: f64, z0: f64, z1: f64) -> [[f64; 3]; 
 }
 
 /// The street surface at ground point (x, z).
-pub(crate) fn shade_road(scene: &Scene, uv: [f64; 2], footprint_m: f64) -> f32 {
+/// Returns the intensity and the region (lane 0, marking 1, parking 2, sidewalk 3 or 4 on a
+/// seam, verge 5): region changes are intensity steps the renderer supersamples.
+pub(crate) fn shade_road(scene: &Scene, uv: [f64; 2], footprint_m: f64) -> (f32, u32) {
     let [x, z] = uv;
     const ASPHALT: Surface = Surface {
         texture: TextureKind::Fractal,
@@ -207,7 +209,8 @@ pub(crate) fn shade_road(scene: &Scene, uv: [f64; 2], footprint_m: f64) -> f32 {
         pattern: Pattern::None,
     };
     let marking = |scene: &Scene| {
-        0.82 + 0.03 * (scene.shade_surface(&ASPHALT, uv, footprint_m, false) - 0.33)
+        let (asphalt, _) = scene.shade_surface(&ASPHALT, uv, footprint_m, false);
+        (0.82 + 0.03 * (asphalt - 0.33), 1)
     };
     if (LANE_LEFT..LANE_RIGHT).contains(&x) {
         // Edge lines, dashed centre line, zebra crossings every 150 m.
@@ -227,7 +230,7 @@ pub(crate) fn shade_road(scene: &Scene, uv: [f64; 2], footprint_m: f64) -> f32 {
         let mut s = ASPHALT;
         s.mean = 0.29;
         s.offset = [311.0, 17.0];
-        return scene.shade_surface(&s, uv, footprint_m, false);
+        return (scene.shade_surface(&s, uv, footprint_m, false).0, 2);
     }
     if (SIDEWALK_LEFT..SIDEWALK_RIGHT).contains(&x) {
         let s = Surface {
@@ -242,7 +245,8 @@ pub(crate) fn shade_road(scene: &Scene, uv: [f64; 2], footprint_m: f64) -> f32 {
                 seam_m: 0.02,
             },
         };
-        return scene.shade_surface(&s, uv, footprint_m, false);
+        let (value, seam) = scene.shade_surface(&s, uv, footprint_m, false);
+        return (value, 3 + seam);
     }
     let gravel = Surface {
         texture: TextureKind::Rough,
@@ -253,7 +257,7 @@ pub(crate) fn shade_road(scene: &Scene, uv: [f64; 2], footprint_m: f64) -> f32 {
         macro_contrast: 0.06,
         pattern: Pattern::None,
     };
-    scene.shade_surface(&gravel, uv, footprint_m, false)
+    (scene.shade_surface(&gravel, uv, footprint_m, false).0, 5)
 }
 
 /// The lab of thesis 5.1.1: a closed room with textured furniture 1-5 m from the head.

@@ -5,8 +5,9 @@
 //! pixel integration is sampled. To keep a 640x480 image within a few tens of milliseconds the
 //! integration is adaptive: one ray per pixel centre, with textures prefiltered over the pixel
 //! footprint (mip maps), and an `n`x`n` stratified grid wherever a pixel's centre sample
-//! differs from a 4-neighbour in the surface it hit or by more than a contrast threshold, i.e.
-//! on geometric edges and pattern edges, where prefiltering cannot help.
+//! differs from a 4-neighbour in the surface it hit or in the pattern region on it (window or
+//! wall, marking or asphalt), i.e. on geometric and pattern edges, where prefiltering cannot
+//! help.
 //!
 //! Candidate boxes are binned per 16x16-pixel tile from their exact projected bounding boxes
 //! (boxes straddling the camera plane go to every tile) and sorted by their nearest depth so a
@@ -47,9 +48,6 @@ pub struct MotionBlur {
 const TILE: usize = 16;
 /// Boxes whose nearest point is farther than this are not drawn (1 m there is ~1 pixel).
 pub(crate) const DRAW_DISTANCE_M: f64 = 600.0;
-/// A centre sample that differs from a neighbour by more than this (intensity in [0, 1]) is
-/// supersampled: it is on a pattern edge that the mip maps do not prefilter.
-const EDGE_CONTRAST: f32 = 0.12;
 /// Shading of the six box faces (−x, +x, −y, +y, −z, +z outward normals): a light from above,
 /// slightly from the left and behind the head.
 const FACE_SHADE: [f32; 6] = [0.78, 0.92, 1.0, 0.45, 0.86, 0.66];
@@ -78,7 +76,8 @@ pub(crate) struct RenderSpec {
 }
 
 /// What a sample ray hit: `id` names the surface (sky 0, ground 1, box face `2 + 6 box + face`)
-/// so that edges between surfaces can be found.
+/// and, in its low 3 bits, the pattern region on it, so that edges between surfaces and
+/// pattern edges (windows, markings) can be found.
 #[derive(Debug, Clone, Copy)]
 struct Sample {
     id: u32,
@@ -199,8 +198,7 @@ pub(crate) fn render(scene: &Scene, poses: &[CameraPose], spec: &RenderSpec) -> 
                 let v = frame_v(r);
                 for (i, px) in row.iter_mut().enumerate() {
                     let c = centres[r * w + i];
-                    let differs =
-                        |n: &Sample| n.id != c.id || (n.value - c.value).abs() > EDGE_CONTRAST;
+                    let differs = |n: &Sample| n.id != c.id;
                     let on_edge = (i > 0 && differs(&centres[r * w + i - 1]))
                         || (i + 1 < w && differs(&centres[r * w + i + 1]))
                         || (r > 0 && differs(&centres[(r - 1) * w + i]))
@@ -308,21 +306,22 @@ impl Tracer<'_> {
                 1 => [p.x, p.z],
                 _ => [p.x, p.y],
             };
-            let value = self
+            let (value, region) = self
                 .scene
-                .shade(&b.material, uv, footprint(axis), axis == 0)
-                * FACE_SHADE[face];
+                .shade(&b.material, uv, footprint(axis), axis == 0);
             return Sample {
-                id: 2 + 6 * index + face as u32,
-                value,
+                id: (2 + 6 * index + face as u32) << 3 | region,
+                value: value * FACE_SHADE[face],
             };
         }
         if ground {
             if let Some(material) = &self.scene.ground {
                 let p = o + d * best_t;
-                let value =
-                    self.scene.shade(material, [p.x, p.z], footprint(1), false) * GROUND_SHADE;
-                return Sample { id: 1, value };
+                let (value, region) = self.scene.shade(material, [p.x, p.z], footprint(1), false);
+                return Sample {
+                    id: 1 << 3 | region,
+                    value: value * GROUND_SHADE,
+                };
             }
         }
         let value = self

@@ -227,16 +227,19 @@ impl Scene {
     }
 
     /// Intensity of `material` at texture coordinates `uv` (metres on the surface), filtered
-    /// over `footprint_m`. `street_facing` enables façade windows (faces normal to x).
+    /// over `footprint_m`, and the pattern region the point is in (0 = plain texture). The
+    /// noise is prefiltered, the pattern's hard edges are not: the renderer supersamples
+    /// where neighbouring pixels are in different regions. `street_facing` enables façade
+    /// windows (faces normal to x).
     pub(crate) fn shade(
         &self,
         material: &Material,
         uv: [f64; 2],
         footprint_m: f64,
         street_facing: bool,
-    ) -> f32 {
+    ) -> (f32, u32) {
         match material {
-            Material::Flat(v) => *v,
+            Material::Flat(v) => (*v, 0),
             Material::Surface(s) => self.shade_surface(s, uv, footprint_m, street_facing),
             Material::Road => layout::shade_road(self, uv, footprint_m),
         }
@@ -248,7 +251,7 @@ impl Scene {
         uv: [f64; 2],
         footprint_m: f64,
         street_facing: bool,
-    ) -> f32 {
+    ) -> (f32, u32) {
         let tex = &self.textures[s.texture.index()];
         let u = (uv[0] + s.offset[0]) / s.metres_per_texel;
         let v = (uv[1] + s.offset[1]) / s.metres_per_texel;
@@ -259,7 +262,7 @@ impl Scene {
             value += s.macro_contrast * tex.sample_coarse(v / MACRO + 97.0, u / MACRO, fp / MACRO);
         }
         match s.pattern {
-            Pattern::None => value,
+            Pattern::None => (value, 0),
             Pattern::Windows {
                 spacing,
                 size,
@@ -276,19 +279,26 @@ impl Scene {
                 if inside {
                     // Curtains and reflections: each window its own brightness.
                     let h = hash2(cu, cv);
-                    glass + 0.35 * h + 0.04 * (value - s.mean)
+                    (glass + 0.35 * h + 0.04 * (value - s.mean), 1)
                 } else {
-                    value
+                    (value, 0)
                 }
             }
-            Pattern::Windows { .. } => value,
+            Pattern::Windows { .. } => (value, 0),
             Pattern::Paving { tile_m, seam_m } => {
+                const SEAM_DARKEN: f32 = 0.45;
+                if footprint_m > 2.0 * seam_m {
+                    // Seams thinner than the footprint: their mean darkening (they cover
+                    // about 2·seam/tile of the surface), instead of aliasing.
+                    let cover = (2.0 * seam_m / tile_m).min(1.0) as f32;
+                    return (value * (1.0 - SEAM_DARKEN * cover), 0);
+                }
                 let (_, fu) = cell(uv[0], tile_m);
                 let (_, fv) = cell(uv[1], tile_m);
                 if fu < seam_m || fv < seam_m {
-                    value * 0.55
+                    (value * (1.0 - SEAM_DARKEN), 1)
                 } else {
-                    value
+                    (value, 0)
                 }
             }
         }
