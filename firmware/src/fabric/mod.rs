@@ -10,7 +10,7 @@
 //! | signal | format |
 //! |---|---|
 //! | camera pixel | `u8` |
-//! | scale images G0..G3 | `u16` Q8.8 (octave 0 input is `pixel << 8`) |
+//! | scale images G0..G3 | `u16` Q8.8 (octave 0 input is `pixel << 8`; G0 is the input filter in octave 0 and the subsampled G3 of the previous octave in octaves 1..) |
 //! | taps | 10-bit, sum 1024 ([`taps`]) |
 //! | DoG | `i16` Q8.8, saturating |
 //! | Sobel `Sx, Sy` | 19-bit signed |
