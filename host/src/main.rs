@@ -1,4 +1,9 @@
 //! The `stereocal` command line.
+
+mod cli;
+
+use clap::Parser;
+
 fn main() -> anyhow::Result<()> {
-    anyhow::bail!("stereocal: command line not wired yet")
+    cli::Cli::parse().run()
 }

@@ -386,3 +386,20 @@ fn pairs_keep_a_damaged_partner_and_split_lone_frames() {
     assert_eq!((l.camera, r.camera), (Camera::Left, Camera::Right));
     assert_eq!(bytes, l.wire_bytes + r.wire_bytes);
 }
+
+#[test]
+fn packets_of_an_unknown_kind_are_counted_not_damage() {
+    let mut wire = Wire::new();
+    let packets = frame_packets(&FrameSpec::small(11, Camera::Left));
+    for (i, p) in packets.iter().enumerate() {
+        wire.push(&p.repr());
+        if i == 2 {
+            wire.unknown_kind(0x30, &[1, 0, 2, 3]);
+        }
+    }
+    let mut d = driver(&wire);
+    let f = delivered(d.next_frame(T).unwrap());
+    assert_eq!(f.frame_id, 11);
+    let s = d.stats();
+    assert_eq!((s.unknown_kinds, s.undecodable, s.sequence_gaps), (1, 0, 0));
+}

@@ -192,6 +192,13 @@ mod soft_core {
                 }
             }
         }
+        let dropped_logs = stereocal_firmware::softcore::dropped_logs();
+        if dropped_logs > 0 {
+            defmt::error!(
+                "{=u32} log frames were too long or hit a busy link",
+                dropped_logs
+            );
+        }
         stop(if failed {
             ExitCode::FrameFailed
         } else {

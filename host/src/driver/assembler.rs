@@ -166,6 +166,8 @@ impl Partial {
 pub(crate) struct FrameAssembler {
     last_seq: Option<u16>,
     partial: Option<Partial>,
+    /// Intact packets of unknown kind since the last decoded one (each took a number).
+    unknown_since_last: u16,
     events: VecDeque<Event>,
     pub stats: LinkStats,
 }
@@ -255,7 +257,19 @@ impl FrameAssembler {
     }
 
     /// A link frame that did not decode; `wire_len` is the bytes it took.
+    ///
+    /// An intact packet of a kind this host does not know (a newer device may add kinds
+    /// within a version) is counted and skipped without damage; it used up one sequence
+    /// number, which [`Self::check_seq`] allows for.
     pub fn undecodable(&mut self, error: stereocal_wire::Error, wire_len: usize) {
+        if error == stereocal_wire::Error::DecodeUnknownKind {
+            self.stats.unknown_kinds += 1;
+            self.unknown_since_last = self.unknown_since_last.wrapping_add(1);
+            if let Some(p) = &mut self.partial {
+                p.wire_bytes += wire_len as u64;
+            }
+            return;
+        }
         self.stats.undecodable += 1;
         let after_seq = self.last_seq.unwrap_or(0);
         if let Some(p) = &mut self.partial {
@@ -276,9 +290,10 @@ impl FrameAssembler {
 
     /// Checks the sequence number; returns the expected one when it jumped.
     fn check_seq(&mut self, seq: u16) -> Option<u16> {
+        let skipped = std::mem::take(&mut self.unknown_since_last);
         let gap = match self.last_seq {
-            Some(last) if seq != last.wrapping_add(1) => {
-                let expected = last.wrapping_add(1);
+            Some(last) if seq != last.wrapping_add(1).wrapping_add(skipped) => {
+                let expected = last.wrapping_add(1).wrapping_add(skipped);
                 self.stats.sequence_gaps += 1;
                 self.stats.packets_lost += u64::from(seq.wrapping_sub(expected));
                 Some(expected)
@@ -298,6 +313,7 @@ impl FrameAssembler {
             // A device that says Hello has (re)started: its numbering starts over, and a
             // frame it was sending will not be finished.
             self.last_seq = Some(seq);
+            self.unknown_since_last = 0;
             if let Some(p) = self.partial.take() {
                 let next = PacketRef {
                     kind: header.kind,

@@ -17,6 +17,8 @@ pub struct LinkStats {
     pub packets: u64,
     /// Frames on the link that did not decode (bad COBS, CRC, version, length, kind, fields).
     pub undecodable: u64,
+    /// Intact packets of a kind this host does not know (counted and skipped, no damage).
+    pub unknown_kinds: u64,
     /// Frames on the link longer than any packet (skipped).
     pub over_long: u64,
     /// Jumps in the sequence numbers.

@@ -84,10 +84,21 @@ struct Sample {
     value: f32,
 }
 
-/// The candidate boxes of every tile, nearest first, with the depth below which none is hit.
+/// A candidate box as a tile stores it: the depth below which it cannot be hit and its bounds
+/// inline, so the intersection loop walks one contiguous list instead of the scene's boxes.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    near: f64,
+    min: [f64; 3],
+    max: [f64; 3],
+    index: u32,
+}
+
+/// The candidate boxes of every tile, nearest first.
 struct Bins {
     tiles_x: usize,
-    tiles: Vec<Vec<(f64, u32)>>,
+    tiles_y: usize,
+    tiles: Vec<Vec<Candidate>>,
 }
 
 impl Bins {
@@ -95,7 +106,7 @@ impl Bins {
     fn new(scene: &Scene, poses: &[CameraPose], width: u32, height: u32) -> Self {
         let tiles_x = (width as usize).div_ceil(TILE);
         let tiles_y = (height as usize).div_ceil(TILE);
-        let mut tiles: Vec<Vec<(f64, u32)>> = vec![Vec::new(); tiles_x * tiles_y];
+        let mut tiles: Vec<Vec<Candidate>> = vec![Vec::new(); tiles_x * tiles_y];
         for (index, b) in scene.boxes.iter().enumerate() {
             let mut near = f64::INFINITY;
             let mut straddles = false;
@@ -132,7 +143,12 @@ impl Bins {
             if behind || near > DRAW_DISTANCE_M {
                 continue;
             }
-            let item = (near.max(0.0), index as u32);
+            let item = Candidate {
+                near: near.max(0.0),
+                min: b.min,
+                max: b.max,
+                index: index as u32,
+            };
             let (tx0, tx1, ty0, ty1) = if straddles {
                 (0, tiles_x - 1, 0, tiles_y - 1)
             } else {
@@ -162,15 +178,19 @@ impl Bins {
             }
         }
         for list in &mut tiles {
-            list.sort_by(|a, b| a.0.total_cmp(&b.0));
+            list.sort_by(|a, b| a.near.total_cmp(&b.near));
         }
-        Bins { tiles_x, tiles }
+        Bins {
+            tiles_x,
+            tiles_y,
+            tiles,
+        }
     }
 
-    fn at(&self, u: f64, v: f64) -> &[(f64, u32)] {
+    fn at(&self, u: f64, v: f64) -> &[Candidate] {
         // Sample positions lie within the frame's pixel grid; clamp guards the margins.
         let tx = ((u + 0.5).max(0.0) as usize / TILE).min(self.tiles_x - 1);
-        let ty = ((v + 0.5).max(0.0) as usize / TILE).min(self.tiles.len() / self.tiles_x - 1);
+        let ty = ((v + 0.5).max(0.0) as usize / TILE).min(self.tiles_y - 1);
         &self.tiles[ty * self.tiles_x + tx]
     }
 }
@@ -267,11 +287,10 @@ impl Tracer<'_> {
                 ground = true;
             }
         }
-        for &(near, index) in self.bins.at(u, v) {
-            if near >= best_t {
+        for b in self.bins.at(u, v) {
+            if b.near >= best_t {
                 break;
             }
-            let b = &self.scene.boxes[index as usize];
             let mut t_in = f64::NEG_INFINITY;
             let mut t_out = f64::INFINITY;
             let mut axis = 0usize;
@@ -287,7 +306,7 @@ impl Tracer<'_> {
             }
             if t_in <= t_out && t_in > 0.0 && t_in < best_t {
                 best_t = t_in;
-                best = Some((index, axis));
+                best = Some((b.index, axis));
                 ground = false;
             }
         }

@@ -241,3 +241,23 @@ pub fn frame_packets(spec: &FrameSpec) -> Vec<Owned> {
     }));
     out
 }
+
+impl Wire {
+    /// An intact packet of a kind the host does not know (a newer device's), numbered like
+    /// the others. Built by hand because the wire crate only encodes kinds it knows.
+    pub fn unknown_kind(&mut self, kind: u8, payload: &[u8]) {
+        let mut packet = vec![stereocal_wire::PROTOCOL_VERSION, kind];
+        packet.extend_from_slice(&self.seq.to_le_bytes());
+        packet.extend_from_slice(&(payload.len() as u16).to_le_bytes());
+        packet.extend_from_slice(payload);
+        let crc = stereocal_wire::crc32c(&packet);
+        packet.extend_from_slice(&crc.to_le_bytes());
+        self.seq = self.seq.wrapping_add(1);
+        let start = self.bytes.len();
+        let mut encoded = vec![0u8; cobs::max_encoding_length(packet.len())];
+        let n = cobs::encode(&packet, &mut encoded);
+        self.bytes.extend_from_slice(&encoded[..n]);
+        self.bytes.push(0);
+        self.packets.push(start..self.bytes.len());
+    }
+}

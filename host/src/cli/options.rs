@@ -1,0 +1,90 @@
+//! Flags shared by every command that estimates: the estimator's knobs and the output mode.
+//!
+//! The defaults are the estimator's defaults, the most accurate settings for a verge head;
+//! each flag only moves away from them.
+
+use clap::{Args, ValueEnum};
+use stereocal::estimator::Model;
+use stereocal::session::SessionConfig;
+use stereocal_hdl::regs::output_mode::SobelOutput;
+
+/// Essential-matrix model (`--model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModelArg {
+    /// Both cameras only yaw (the thesis' 4-unknown model).
+    Constrained,
+    /// Free relative rotation (5 DOF), for heads that also tilt.
+    General,
+}
+
+/// What the fabric streams besides the points (`--sobel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SobelArg {
+    /// Every Sobel pixel of octave 0 (the thesis' mode; enables sub-pixel refinement).
+    Rows,
+    /// 16x16 patches around each point (low bandwidth).
+    Patches,
+}
+
+#[derive(Debug, Clone, Args)]
+pub struct EstimateArgs {
+    /// Robust RANSAC start for the refinement (the default; `--no-ransac` turns it off).
+    #[arg(long, overrides_with = "no_ransac")]
+    ransac: bool,
+    /// Start the refinement from parallel cameras instead of a RANSAC hypothesis.
+    #[arg(long, overrides_with = "ransac")]
+    no_ransac: bool,
+    /// Lowe's ratio test: best distance < RATIO x second best, in (0, 1).
+    #[arg(long, default_value_t = 0.6, value_parser = parse_ratio)]
+    ratio: f32,
+    /// Keep only the N best matches (default: every match that passes the tests).
+    #[arg(long, value_parser = parse_best)]
+    best: Option<usize>,
+    /// Essential-matrix model.
+    #[arg(long, value_enum, default_value_t = ModelArg::Constrained)]
+    model: ModelArg,
+    /// Sobel output mode of the fabric.
+    #[arg(long, value_enum, default_value_t = SobelArg::Rows)]
+    sobel: SobelArg,
+}
+
+impl EstimateArgs {
+    pub fn session_config(&self) -> SessionConfig {
+        let mut config = SessionConfig::default();
+        let e = &mut config.estimator;
+        if self.no_ransac {
+            e.ransac = None;
+        }
+        e.matching.ratio = self.ratio;
+        e.matching.best_n = self.best;
+        e.model = match self.model {
+            ModelArg::Constrained => Model::Constrained,
+            ModelArg::General => Model::General,
+        };
+        config.sobel_output = match self.sobel {
+            SobelArg::Rows => SobelOutput::Rows,
+            SobelArg::Patches => SobelOutput::Patches,
+        };
+        config
+    }
+}
+
+fn parse_ratio(s: &str) -> Result<f32, String> {
+    let r: f32 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if r > 0.0 && r < 1.0 {
+        Ok(r)
+    } else {
+        Err(format!("{r} is outside (0, 1)"))
+    }
+}
+
+fn parse_best(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .parse()
+        .map_err(|_| format!("`{s}` is not a whole number"))?;
+    if n == 0 {
+        Err("must be at least 1".into())
+    } else {
+        Ok(n)
+    }
+}

@@ -1,0 +1,150 @@
+//! `stereocal run`: a recorded stereo sequence (a directory per camera) through the chain.
+
+use std::path::PathBuf;
+use std::sync::mpsc;
+
+use anyhow::Context;
+use clap::Args;
+use stereocal::calib::Calibration;
+use stereocal::record::FrameRecord;
+use stereocal::sequence::{GrayFrame, SizeLimits, StereoSequence};
+use stereocal::session::Session;
+use stereocal::summary::{Residual, RunCost, Summary};
+use stereocal::verge_csv::read_truth_csv;
+use stereocal_hdl::regs::{MAX_HEIGHT, MAX_WIDTH, MIN_SIDE};
+
+use super::options::EstimateArgs;
+use super::output::{finish, progress_bar, Finish};
+
+/// Pairs decoded ahead of the chain.
+const LOOKAHEAD: usize = 3;
+
+#[derive(Debug, Clone, Args)]
+pub struct RunArgs {
+    /// Directory of left-camera images (PNG, PGM, JPEG), paired with the right by sorted name.
+    #[arg(long)]
+    left: PathBuf,
+    /// Directory of right-camera images.
+    #[arg(long)]
+    right: PathBuf,
+    /// Calibration file (TOML: baseline_m, [left] and [right] fx, fy, cx, cy).
+    #[arg(long)]
+    calib: PathBuf,
+    /// Ground truth `frame,verge_deg`: the error statistics are reported against it. A real
+    /// rig's own constant residual verge is removed first.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// Where verge.csv and verge.png go.
+    #[arg(long, default_value = "out/run")]
+    out: PathBuf,
+    /// Frame rate of the sequence (the filter's time step).
+    #[arg(long, default_value_t = 30.0, value_parser = parse_fps)]
+    fps: f64,
+    #[command(flatten)]
+    estimate: EstimateArgs,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(args: &RunArgs) -> anyhow::Result<()> {
+    // Everything that can be checked before the first frame is, so a bad call writes nothing.
+    let calib = Calibration::load(&args.calib)?;
+    let limits = SizeLimits {
+        max_width: MAX_WIDTH as usize,
+        min_side: MIN_SIDE as usize,
+    };
+    let sequence = StereoSequence::open(&args.left, &args.right, limits)?;
+    let truth = match &args.truth {
+        Some(path) => {
+            let truth = read_truth_csv(path)?;
+            anyhow::ensure!(
+                truth.len() >= sequence.len(),
+                "{}: has {} frames, the sequence {}",
+                path.display(),
+                truth.len(),
+                sequence.len()
+            );
+            Some(truth)
+        }
+        None => None,
+    };
+    let (first, _) = sequence.pair(0, None)?;
+    let size = (first.width, first.height);
+    anyhow::ensure!(
+        first.height <= MAX_HEIGHT as usize,
+        "frame 0: image is {}x{}; the fabric takes at most {MAX_HEIGHT} lines",
+        first.width,
+        first.height
+    );
+    let mut session = Session::new(
+        calib,
+        first.width as u16,
+        first.height as u16,
+        args.estimate.session_config(),
+    )
+    .context("cannot start the device")?;
+
+    let bar = progress_bar(sequence.len() as u64, "estimating");
+    let period_us = 1e6 / args.fps;
+    let records = std::thread::scope(|scope| -> anyhow::Result<Vec<FrameRecord>> {
+        let (tx, rx) = mpsc::sync_channel::<anyhow::Result<(GrayFrame, GrayFrame)>>(LOOKAHEAD);
+        let sequence = &sequence;
+        scope.spawn(move || {
+            for frame in 0..sequence.len() {
+                let pair = sequence
+                    .pair(frame, Some(size))
+                    .map_err(anyhow::Error::from);
+                let stop = pair.is_err();
+                if tx.send(pair).is_err() || stop {
+                    break;
+                }
+            }
+        });
+        let mut records = Vec::with_capacity(sequence.len());
+        for (frame, pair) in rx.into_iter().enumerate() {
+            let (l, r) = pair?;
+            let record = session.process(
+                frame,
+                Some((&l.pixels, &r.pixels)),
+                size,
+                (frame as f64 * period_us).round() as u64,
+                truth.as_ref().map(|t| t[frame]),
+            )?;
+            bar.inc(1);
+            records.push(record);
+        }
+        Ok(records)
+    })?;
+    bar.finish_and_clear();
+    let cost = session.cost();
+    let summary = Summary::from_records(
+        &records,
+        Residual::Remove,
+        RunCost {
+            ms_per_frame_pair: cost.ms_per_pair(),
+            wire_bytes_per_pair: cost.wire_bytes_per_pair(),
+        },
+    );
+    let title = format!("stereocal run: {}", args.left.display());
+    finish(
+        &records,
+        &summary,
+        truth.is_some(),
+        (size.0 as u32, size.1 as u32),
+        Finish {
+            out: Some(&args.out),
+            json: args.json,
+            title: &title,
+        },
+    )
+}
+
+fn parse_fps(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if v.is_finite() && v > 0.0 && v <= 10_000.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside (0, 10000]"))
+    }
+}

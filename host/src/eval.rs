@@ -1,0 +1,86 @@
+//! Ground-truth runs: a rendered sequence through the whole chain (fabric model → wire →
+//! host), each record carrying the renderer's exact verge.
+//!
+//! Rendering runs on its own thread a few frames ahead of the chain, so the two overlap on a
+//! multi-core machine; the session's cost counts only the chain.
+
+use std::sync::mpsc;
+
+use crate::calib::{CalibError, Calibration};
+use crate::record::FrameRecord;
+use crate::session::{Session, SessionConfig, SessionCost, SessionError};
+use crate::synth::{Sequence, StereoFrame, SynthError};
+
+/// Frames rendered ahead of the chain.
+const LOOKAHEAD: usize = 3;
+
+/// Why a ground-truth run failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum EvalError {
+    #[error(transparent)]
+    Synth(#[from] SynthError),
+    #[error("synthetic calibration: {0}")]
+    Calib(#[from] CalibError),
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error("frame {frame}: image size {width}x{height} does not fit the fabric's registers")]
+    Size {
+        frame: usize,
+        width: u32,
+        height: u32,
+    },
+}
+
+/// The calibration the renderer's cameras have.
+pub fn sequence_calibration(sequence: &Sequence) -> Result<Calibration, CalibError> {
+    Calibration::from_toml_str(&sequence.calib_toml(), "<synthetic head>")
+}
+
+/// Runs every frame of `sequence`; `progress` is called after each frame.
+pub fn evaluate(
+    sequence: &Sequence,
+    config: SessionConfig,
+    progress: &mut dyn FnMut(&FrameRecord),
+) -> Result<(Vec<FrameRecord>, SessionCost), EvalError> {
+    let calib = sequence_calibration(sequence)?;
+    let (width, height) = sequence.image_size();
+    let size = |frame| EvalError::Size {
+        frame,
+        width,
+        height,
+    };
+    let w = u16::try_from(width).map_err(|_| size(0))?;
+    let h = u16::try_from(height).map_err(|_| size(0))?;
+    let mut session = Session::new(calib, w, h, config)?;
+    std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::sync_channel::<Result<StereoFrame, SynthError>>(LOOKAHEAD);
+        scope.spawn(move || {
+            for index in 0..sequence.len() {
+                let frame = sequence.frame(index);
+                let stop = frame.is_err();
+                if tx.send(frame).is_err() || stop {
+                    break;
+                }
+            }
+        });
+        let mut records = Vec::with_capacity(sequence.len());
+        for frame in rx {
+            let frame = frame?;
+            let images = frame
+                .images
+                .as_ref()
+                .map(|i| (i.left.as_raw().as_slice(), i.right.as_raw().as_slice()));
+            let record = session.process(
+                frame.index,
+                images,
+                (width as usize, height as usize),
+                frame.timestamp_us,
+                Some(frame.truth.verge_deg),
+            )?;
+            progress(&record);
+            records.push(record);
+        }
+        Ok((records, session.cost()))
+    })
+}

@@ -1,0 +1,55 @@
+//! One row of the per-frame verge output: what the estimator said about one frame pair.
+//!
+//! This is the unit every output (CSV, plot, summary) is made from, so the three can never
+//! disagree about a frame.
+
+use std::fmt;
+
+/// Whether a frame pair produced a measurement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameStatus {
+    /// The estimator produced a verge measurement.
+    Ok,
+    /// The frame arrived intact but held too little geometry to measure the verge
+    /// (texture-less scene, too few consistent matches).
+    NoEstimate,
+    /// The frame never arrived intact (damaged on the link, lost, or dropped at the source).
+    Dropped,
+}
+
+impl FrameStatus {
+    /// The spelling used in `verge.csv`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FrameStatus::Ok => "ok",
+            FrameStatus::NoEstimate => "no_estimate",
+            FrameStatus::Dropped => "dropped",
+        }
+    }
+}
+
+impl fmt::Display for FrameStatus {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The estimator's output for one frame pair, plus the truth when it is known.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameRecord {
+    /// Index of the frame pair in the sequence.
+    pub frame: usize,
+    /// The per-frame measurement, `None` unless `status` is `Ok`.
+    pub raw_verge_deg: Option<f64>,
+    /// The Kalman estimate after this frame, `None` unless `status` is `Ok`.
+    pub filtered_verge_deg: Option<f64>,
+    /// One standard deviation of the Kalman estimate, `None` unless `status` is `Ok`.
+    pub filtered_sigma_deg: Option<f64>,
+    /// Matches that passed the ratio test.
+    pub matches: usize,
+    /// Matches consistent with the estimated geometry.
+    pub inliers: usize,
+    pub status: FrameStatus,
+    /// Ground-truth verge, when a truth file or the renderer gives it.
+    pub truth_deg: Option<f64>,
+}

@@ -1,0 +1,305 @@
+//! Stereo image sequences on disk: a directory per camera, files paired by sorted name,
+//! PNG / PGM / JPEG, colour converted to 8-bit grey.
+//!
+//! Everything that can be checked before the first frame is processed (directories exist, hold
+//! images, the same number of them) is checked in `open`, so a bad invocation fails at once and
+//! writes nothing; each pair is decoded only when it is needed.
+
+use std::path::{Path, PathBuf};
+
+/// An 8-bit grey image, row-major.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GrayFrame {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<u8>,
+}
+
+/// A stereo sequence that cannot be read, naming the directory, file or frame at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum SequenceError {
+    #[error("{camera} image directory {path} does not exist or is not a directory")]
+    MissingDir { camera: &'static str, path: PathBuf },
+    #[error("{camera} image directory {path} cannot be listed: {source}")]
+    ListDir {
+        camera: &'static str,
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{camera} image directory {path} holds no .png, .pgm, .jpg or .jpeg files")]
+    Empty { camera: &'static str, path: PathBuf },
+    #[error("left directory has {left} images but right directory has {right}; frames are paired by sorted name")]
+    CountMismatch { left: usize, right: usize },
+    #[error("{path}: cannot decode image: {source}")]
+    Decode {
+        path: PathBuf,
+        source: image::ImageError,
+    },
+    #[error("frame {frame}: left image {left_w}x{left_h} and right image {right_w}x{right_h} differ in size")]
+    PairSize {
+        frame: usize,
+        left_w: usize,
+        left_h: usize,
+        right_w: usize,
+        right_h: usize,
+    },
+    #[error("frame {frame}: image size {width}x{height} differs from the first frame's {first_w}x{first_h}")]
+    SizeChanged {
+        frame: usize,
+        width: usize,
+        height: usize,
+        first_w: usize,
+        first_h: usize,
+    },
+    #[error(
+        "frame {frame}: image is {width} px wide; the fabric's line buffers hold at most {max} px"
+    )]
+    TooWide {
+        frame: usize,
+        width: usize,
+        max: usize,
+    },
+    #[error("frame {frame}: image is {width}x{height}; the pyramid needs at least {min}x{min}")]
+    TooSmall {
+        frame: usize,
+        width: usize,
+        height: usize,
+        min: usize,
+    },
+}
+
+/// Limits the fabric puts on the image size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SizeLimits {
+    pub max_width: usize,
+    pub min_side: usize,
+}
+
+/// The file names of a stereo sequence, checked and paired.
+#[derive(Debug, Clone)]
+pub struct StereoSequence {
+    left: Vec<PathBuf>,
+    right: Vec<PathBuf>,
+    limits: SizeLimits,
+}
+
+impl StereoSequence {
+    /// Lists and pairs the two directories.
+    pub fn open(left: &Path, right: &Path, limits: SizeLimits) -> Result<Self, SequenceError> {
+        let left = list_images("left", left)?;
+        let right = list_images("right", right)?;
+        if left.len() != right.len() {
+            return Err(SequenceError::CountMismatch {
+                left: left.len(),
+                right: right.len(),
+            });
+        }
+        Ok(StereoSequence {
+            left,
+            right,
+            limits,
+        })
+    }
+
+    /// Number of frame pairs.
+    pub fn len(&self) -> usize {
+        self.left.len()
+    }
+
+    /// Always false once `open` succeeded; present for API completeness with `len`.
+    pub fn is_empty(&self) -> bool {
+        self.left.is_empty()
+    }
+
+    /// Decodes pair `frame`, checking it against the limits and against `first` (the size of
+    /// frame 0, once known).
+    pub fn pair(
+        &self,
+        frame: usize,
+        first: Option<(usize, usize)>,
+    ) -> Result<(GrayFrame, GrayFrame), SequenceError> {
+        let l = load_gray(&self.left[frame])?;
+        let r = load_gray(&self.right[frame])?;
+        if (l.width, l.height) != (r.width, r.height) {
+            return Err(SequenceError::PairSize {
+                frame,
+                left_w: l.width,
+                left_h: l.height,
+                right_w: r.width,
+                right_h: r.height,
+            });
+        }
+        if let Some((first_w, first_h)) = first {
+            if (l.width, l.height) != (first_w, first_h) {
+                return Err(SequenceError::SizeChanged {
+                    frame,
+                    width: l.width,
+                    height: l.height,
+                    first_w,
+                    first_h,
+                });
+            }
+        }
+        if l.width > self.limits.max_width {
+            return Err(SequenceError::TooWide {
+                frame,
+                width: l.width,
+                max: self.limits.max_width,
+            });
+        }
+        if l.width < self.limits.min_side || l.height < self.limits.min_side {
+            return Err(SequenceError::TooSmall {
+                frame,
+                width: l.width,
+                height: l.height,
+                min: self.limits.min_side,
+            });
+        }
+        Ok((l, r))
+    }
+}
+
+fn list_images(camera: &'static str, dir: &Path) -> Result<Vec<PathBuf>, SequenceError> {
+    if !dir.is_dir() {
+        return Err(SequenceError::MissingDir {
+            camera,
+            path: dir.to_owned(),
+        });
+    }
+    let entries = std::fs::read_dir(dir).map_err(|source| SequenceError::ListDir {
+        camera,
+        path: dir.to_owned(),
+        source,
+    })?;
+    let mut files = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|source| SequenceError::ListDir {
+            camera,
+            path: dir.to_owned(),
+            source,
+        })?;
+        let path = entry.path();
+        let is_image = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| {
+                matches!(
+                    e.to_ascii_lowercase().as_str(),
+                    "png" | "pgm" | "jpg" | "jpeg"
+                )
+            })
+            .unwrap_or(false);
+        if is_image && path.is_file() {
+            files.push(path);
+        }
+    }
+    if files.is_empty() {
+        return Err(SequenceError::Empty {
+            camera,
+            path: dir.to_owned(),
+        });
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// Decodes one image file to 8-bit grey (colour by the `image` crate's luma conversion).
+pub fn load_gray(path: &Path) -> Result<GrayFrame, SequenceError> {
+    let img = image::ImageReader::open(path)
+        .map_err(|e| SequenceError::Decode {
+            path: path.to_owned(),
+            source: image::ImageError::IoError(e),
+        })?
+        .with_guessed_format()
+        .map_err(|e| SequenceError::Decode {
+            path: path.to_owned(),
+            source: image::ImageError::IoError(e),
+        })?
+        .decode()
+        .map_err(|source| SequenceError::Decode {
+            path: path.to_owned(),
+            source,
+        })?
+        .into_luma8();
+    Ok(GrayFrame {
+        width: img.width() as usize,
+        height: img.height() as usize,
+        pixels: img.into_raw(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LIMITS: SizeLimits = SizeLimits {
+        max_width: 64,
+        min_side: 8,
+    };
+
+    fn write_png(path: &Path, w: u32, h: u32) {
+        image::GrayImage::from_fn(w, h, |x, y| image::Luma([(x * 7 + y * 3) as u8]))
+            .save(path)
+            .unwrap();
+    }
+
+    fn dirs() -> (tempfile::TempDir, PathBuf, PathBuf) {
+        let root = tempfile::tempdir().unwrap();
+        let l = root.path().join("left");
+        let r = root.path().join("right");
+        std::fs::create_dir(&l).unwrap();
+        std::fs::create_dir(&r).unwrap();
+        (root, l, r)
+    }
+
+    #[test]
+    fn pairs_by_sorted_name_and_checks_sizes() {
+        let (_root, l, r) = dirs();
+        for name in ["b.png", "a.png"] {
+            write_png(&l.join(name), 32, 16);
+            write_png(&r.join(name), 32, 16);
+        }
+        write_png(&r.join("a.png"), 32, 17);
+        let seq = StereoSequence::open(&l, &r, LIMITS).unwrap();
+        assert_eq!(seq.len(), 2);
+        assert!(matches!(
+            seq.pair(0, None),
+            Err(SequenceError::PairSize { frame: 0, .. })
+        ));
+        let (a, _) = seq.pair(1, None).unwrap();
+        assert_eq!((a.width, a.height), (32, 16));
+        assert!(matches!(
+            seq.pair(1, Some((30, 16))),
+            Err(SequenceError::SizeChanged { frame: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn rejects_missing_empty_uneven_wide_and_broken() {
+        let (root, l, r) = dirs();
+        let missing = root.path().join("nope");
+        assert!(matches!(
+            StereoSequence::open(&missing, &r, LIMITS),
+            Err(SequenceError::MissingDir { camera: "left", .. })
+        ));
+        assert!(matches!(
+            StereoSequence::open(&l, &r, LIMITS),
+            Err(SequenceError::Empty { camera: "left", .. })
+        ));
+        write_png(&l.join("0.png"), 100, 16);
+        write_png(&l.join("1.png"), 100, 16);
+        write_png(&r.join("0.png"), 100, 16);
+        assert!(matches!(
+            StereoSequence::open(&l, &r, LIMITS),
+            Err(SequenceError::CountMismatch { left: 2, right: 1 })
+        ));
+        std::fs::write(r.join("1.png"), b"\x89PNG\r\n\x1a\ntruncated").unwrap();
+        let seq = StereoSequence::open(&l, &r, LIMITS).unwrap();
+        assert!(matches!(
+            seq.pair(0, None),
+            Err(SequenceError::TooWide { max: 64, .. })
+        ));
+        let err = seq.pair(1, None).unwrap_err().to_string();
+        assert!(err.contains("1.png"), "{err}");
+    }
+}

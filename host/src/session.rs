@@ -1,0 +1,274 @@
+//! The whole chain for one stereo sequence, frame pair by frame pair: pixels into the device
+//! (fabric model and soft-core driver), wire bytes back through the host driver, then the
+//! estimator and the Kalman filter, giving one [`FrameRecord`] per pair.
+//!
+//! `run`, `eval` and `demo` all go through here, so every number they print comes from the
+//! same path the bytes take on a real head: nothing reaches the estimator except through the
+//! wire format.
+
+use std::time::{Duration, Instant};
+
+use stereocal_hdl::regs::output_mode::SobelOutput;
+use stereocal_hdl::FabricConfig;
+use stereocal_wire::Camera;
+
+use crate::calib::Calibration;
+use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome};
+use crate::estimator::{EstimatorConfig, VergeEstimator};
+use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
+use crate::link::{InProcessLink, LinkError};
+use crate::record::{FrameRecord, FrameStatus};
+
+/// How long the host waits for the device's answer to one request or one frame.
+const DEVICE_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// Settings of a session.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SessionConfig {
+    pub estimator: EstimatorConfig,
+    pub kalman: KalmanConfig,
+    /// Which Sobel output the fabric streams (full rows, as the thesis, or 16x16 patches).
+    pub sobel_output: SobelOutput,
+}
+
+impl Default for SessionConfig {
+    fn default() -> Self {
+        Self {
+            estimator: EstimatorConfig::default(),
+            kalman: KalmanConfig::default(),
+            sobel_output: SobelOutput::Rows,
+        }
+    }
+}
+
+/// The fabric's configuration for `width` x `height` frames.
+///
+/// The contrast threshold is 1 grey level rather than the register's reset value (8, Lowe's
+/// 0.03 of full scale): the verge estimate gains from every stable keypoint, and the ratio
+/// test and RANSAC reject the weak ones that do not match.
+pub fn fabric_config(width: u16, height: u16, sobel_output: SobelOutput) -> FabricConfig {
+    FabricConfig {
+        width,
+        height,
+        contrast_threshold: 1,
+        sobel_output,
+        ..FabricConfig::default()
+    }
+}
+
+/// Why a session stopped.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SessionError {
+    #[error("device link: {0}")]
+    Link(#[from] LinkError),
+    #[error("device: {0}")]
+    Driver(#[from] DriverError),
+    #[error("frame {frame}: {source}")]
+    Time {
+        frame: usize,
+        source: TimeWentBackwards,
+    },
+    #[error("frame {frame}: the device answered with frame id {got}, expected {expected}")]
+    OutOfStep {
+        frame: usize,
+        got: u32,
+        expected: u32,
+    },
+    #[error(
+        "frame {frame}: image is {width}x{height}, the fabric was configured for {configured_w}x{configured_h}"
+    )]
+    SizeChanged {
+        frame: usize,
+        width: usize,
+        height: usize,
+        configured_w: u16,
+        configured_h: u16,
+    },
+}
+
+/// What was spent on the pairs processed so far.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SessionCost {
+    pub pairs: usize,
+    /// Wall time inside [`Session::process`] (device, driver, estimator, filter).
+    pub elapsed: Duration,
+    /// Link bytes of the delivered pairs.
+    pub wire_bytes: u64,
+}
+
+impl SessionCost {
+    pub fn ms_per_pair(&self) -> f64 {
+        if self.pairs == 0 {
+            0.0
+        } else {
+            self.elapsed.as_secs_f64() * 1e3 / self.pairs as f64
+        }
+    }
+
+    pub fn wire_bytes_per_pair(&self) -> f64 {
+        if self.pairs == 0 {
+            0.0
+        } else {
+            self.wire_bytes as f64 / self.pairs as f64
+        }
+    }
+}
+
+/// One stereo head, from pixels to filtered verge angle.
+pub struct Session {
+    driver: Driver<InProcessLink>,
+    fabric: FabricConfig,
+    estimator: VergeEstimator,
+    filter: VergeFilter,
+    next_frame_id: Option<u32>,
+    cost: SessionCost,
+}
+
+impl Session {
+    /// Opens the in-process device, says Hello, configures the fabric for `width` x `height`
+    /// and reads the registers back.
+    pub fn new(
+        calib: Calibration,
+        width: u16,
+        height: u16,
+        config: SessionConfig,
+    ) -> Result<Self, SessionError> {
+        let mut driver = Driver::new(InProcessLink::new()?);
+        driver.hello(DEVICE_TIMEOUT)?;
+        let fabric = fabric_config(width, height, config.sobel_output);
+        driver.configure(&fabric, DEVICE_TIMEOUT)?;
+        driver.enable()?;
+        Ok(Self {
+            driver,
+            fabric,
+            estimator: VergeEstimator::new(calib, config.estimator),
+            filter: VergeFilter::new(config.kalman),
+            next_frame_id: None,
+            cost: SessionCost::default(),
+        })
+    }
+
+    /// The fabric configuration in force.
+    pub fn fabric(&self) -> &FabricConfig {
+        &self.fabric
+    }
+
+    /// Cost so far.
+    pub fn cost(&self) -> SessionCost {
+        self.cost
+    }
+
+    /// Processes frame pair `frame` captured at `timestamp_us`. `images` is `None` for a pair
+    /// the grabber lost: the filter predicts across it and the record says `dropped`.
+    /// A pair damaged on the link is dropped the same way, never estimated.
+    pub fn process(
+        &mut self,
+        frame: usize,
+        images: Option<(&[u8], &[u8])>,
+        image_size: (usize, usize),
+        timestamp_us: u64,
+        truth_deg: Option<f64>,
+    ) -> Result<FrameRecord, SessionError> {
+        let start = Instant::now();
+        let mut record = FrameRecord {
+            frame,
+            raw_verge_deg: None,
+            filtered_verge_deg: None,
+            filtered_sigma_deg: None,
+            matches: 0,
+            inliers: 0,
+            status: FrameStatus::Dropped,
+            truth_deg,
+        };
+        let measurement = match images {
+            None => None,
+            Some((left, right)) => {
+                self.check_size(frame, image_size)?;
+                self.driver
+                    .link_mut()
+                    .submit(Camera::Left, left, timestamp_us)?;
+                self.driver
+                    .link_mut()
+                    .submit(Camera::Right, right, timestamp_us)?;
+                let outcome = self.driver.next_pair(DEVICE_TIMEOUT)?;
+                self.check_step(frame, &outcome)?;
+                self.cost.wire_bytes += outcome.wire_bytes();
+                match outcome {
+                    PairOutcome::Pair {
+                        left: FrameOutcome::Delivered(left),
+                        right: FrameOutcome::Delivered(right),
+                    } => {
+                        record.status = FrameStatus::NoEstimate;
+                        match self.estimator.estimate(&left.features, &right.features) {
+                            Ok(est) => {
+                                record.raw_verge_deg = Some(est.verge_deg);
+                                record.matches = est.matches;
+                                record.inliers = est.inliers;
+                                record.status = FrameStatus::Ok;
+                                Some(Measurement {
+                                    verge_deg: est.verge_deg,
+                                    sigma_deg: est.sigma_deg,
+                                })
+                            }
+                            Err(_) => None,
+                        }
+                    }
+                    _ => None,
+                }
+            }
+        };
+        let filtered = self
+            .filter
+            .step(timestamp_us, measurement)
+            .map_err(|source| SessionError::Time { frame, source })?;
+        if record.status == FrameStatus::Ok {
+            if let Some(f) = filtered {
+                record.filtered_verge_deg = Some(f.verge_deg);
+                record.filtered_sigma_deg = Some(f.sigma_deg);
+            }
+        }
+        self.cost.pairs += 1;
+        self.cost.elapsed += start.elapsed();
+        Ok(record)
+    }
+
+    fn check_size(
+        &self,
+        frame: usize,
+        (width, height): (usize, usize),
+    ) -> Result<(), SessionError> {
+        if (width, height)
+            == (
+                usize::from(self.fabric.width),
+                usize::from(self.fabric.height),
+            )
+        {
+            Ok(())
+        } else {
+            Err(SessionError::SizeChanged {
+                frame,
+                width,
+                height,
+                configured_w: self.fabric.width,
+                configured_h: self.fabric.height,
+            })
+        }
+    }
+
+    /// The device numbers frames itself; a pair that comes back with another id than the
+    /// one submitted means host and device disagree about which images they are.
+    fn check_step(&mut self, frame: usize, outcome: &PairOutcome) -> Result<(), SessionError> {
+        let got = outcome.frame_id();
+        let expected = self.next_frame_id.unwrap_or(got);
+        if got != expected {
+            return Err(SessionError::OutOfStep {
+                frame,
+                got,
+                expected,
+            });
+        }
+        self.next_frame_id = Some(got.wrapping_add(1));
+        Ok(())
+    }
+}
