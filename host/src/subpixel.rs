@@ -51,19 +51,33 @@ pub struct RefinedPair {
     pub sigma_v: f32,
 }
 
-fn bilinear(p: &SobelPlane, x: f32, y: f32) -> Option<f32> {
+/// Samples the `side` x `side` window of `p`'s magnitude centred on (`x`, `y`) into `out`,
+/// bilinearly. The window is a pure translation, so every sample shares one pair of
+/// fractional weights: the bounds are checked once and the loop is four loads and a blend.
+/// `None` when the window (plus its interpolation neighbours) leaves the plane.
+fn sample_window(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> Option<()> {
     let (w, h) = (p.width() as i32, p.height() as i32);
-    let (x0, y0) = (x.floor(), y.floor());
+    let (x0, y0) = ((x - half as f32).floor(), (y - half as f32).floor());
     let (ix, iy) = (x0 as i32, y0 as i32);
-    if ix < 0 || iy < 0 || ix + 1 >= w || iy + 1 >= h {
+    let side = 2 * half + 1;
+    if !(x0.is_finite() && y0.is_finite()) || ix < 0 || iy < 0 || ix + side >= w || iy + side >= h {
         return None;
     }
-    let (fx, fy) = (x - x0, y - y0);
-    let m = p.magnitude();
-    let i = iy as usize * w as usize + ix as usize;
-    let (a, b) = (m[i] as f32, m[i + 1] as f32);
-    let (c, d) = (m[i + w as usize] as f32, m[i + w as usize + 1] as f32);
-    Some((a * (1.0 - fx) + b * fx) * (1.0 - fy) + (c * (1.0 - fx) + d * fx) * fy)
+    let (fx, fy) = (x - half as f32 - x0, y - half as f32 - y0);
+    let (w00, w01) = ((1.0 - fx) * (1.0 - fy), fx * (1.0 - fy));
+    let (w10, w11) = ((1.0 - fx) * fy, fx * fy);
+    let (m, stride, side) = (p.magnitude(), w as usize, side as usize);
+    for (r, row_out) in out.chunks_exact_mut(side).enumerate() {
+        let top = &m[(iy as usize + r) * stride + ix as usize..][..side + 1];
+        let bottom = &m[(iy as usize + r + 1) * stride + ix as usize..][..side + 1];
+        for (c, o) in row_out.iter_mut().enumerate() {
+            *o = w00 * f32::from(top[c])
+                + w01 * f32::from(top[c + 1])
+                + w10 * f32::from(bottom[c])
+                + w11 * f32::from(bottom[c + 1]);
+        }
+    }
+    Some(())
 }
 
 /// Refines one match: `left` / `right` in full-resolution pixels. `None` when rejected.
@@ -118,13 +132,7 @@ pub fn refine_pair(
     let mut warped = vec![0f32; n];
     let mut converged = false;
     for _ in 0..config.max_iterations {
-        for r in 0..side {
-            for c in 0..side {
-                let x = p[0] + (c as i32 - half) as f32;
-                let y = p[1] + (r as i32 - half) as f32;
-                warped[r * side + c] = bilinear(right_plane, x, y)?;
-            }
-        }
+        sample_window(right_plane, p[0], p[1], half, &mut warped)?;
         let mean = warped.iter().sum::<f32>() / n as f32;
         let norm = warped
             .iter()
@@ -160,13 +168,7 @@ pub fn refine_pair(
         return None;
     }
     // Quality at the solution: correlation and the vertical position uncertainty.
-    for r in 0..side {
-        for c in 0..side {
-            let x = p[0] + (c as i32 - half) as f32;
-            let y = p[1] + (r as i32 - half) as f32;
-            warped[r * side + c] = bilinear(right_plane, x, y)?;
-        }
-    }
+    sample_window(right_plane, p[0], p[1], half, &mut warped)?;
     let mean = warped.iter().sum::<f32>() / n as f32;
     let norm = warped
         .iter()
