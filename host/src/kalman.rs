@@ -5,7 +5,10 @@
 //! between frames (`dt` from the timestamps, not a frame count). A measurement whose
 //! innovation exceeds `gate_sigmas` standard deviations is rejected (a bad frame must not pull
 //! the estimate); after `reset_after_rejections` consecutive rejections the filter restarts
-//! from the measurement (the head really moved faster than the model allows). Frames without
+//! from the measurement (the head really moved faster than the model allows). A restart takes
+//! its rate from the previous rejected measurement: the rejections that end in a restart are
+//! the start or the end of a move, and starting at rate 0 in the middle of a move (or at the
+//! old rate after it stopped) would lag or overshoot it for several frames. Frames without
 //! a measurement are predicted and marked, never updated with an invented value.
 
 use nalgebra::{Matrix2, Vector2};
@@ -32,7 +35,7 @@ impl Default for KalmanConfig {
             min_measurement_sigma_deg: 0.01,
             gate_sigmas: 4.0,
             initial_rate_sigma: 10.0,
-            reset_after_rejections: 4,
+            reset_after_rejections: 2,
         }
     }
 }
@@ -89,6 +92,8 @@ pub struct VergeFilter {
     config: KalmanConfig,
     state: Option<State>,
     rejections: usize,
+    /// The last rejected measurement and its time, while rejections are consecutive.
+    last_rejected: Option<(u64, Measurement)>,
 }
 
 impl VergeFilter {
@@ -97,6 +102,7 @@ impl VergeFilter {
             config,
             state: None,
             rejections: 0,
+            last_rejected: None,
         }
     }
 
@@ -140,12 +146,14 @@ impl VergeFilter {
                 s.p = (Matrix2::identity() - kh) * s.p;
                 s.p = 0.5 * (s.p + s.p.transpose());
                 self.rejections = 0;
+                self.last_rejected = None;
                 status = FilterStatus::Updated;
             } else {
                 self.rejections += 1;
                 if self.rejections >= self.config.reset_after_rejections {
                     return Ok(Some(self.restart(timestamp_us, m)));
                 }
+                self.last_rejected = Some((timestamp_us, m));
                 status = FilterStatus::Rejected;
             }
         }
@@ -166,23 +174,34 @@ impl VergeFilter {
         }
     }
 
+    /// Starts over from `m`; the rate comes from the previous rejected measurement when there
+    /// is one (a move under way), else it is unknown (zero, with the configured prior).
     fn restart(&mut self, t_us: u64, m: Measurement) -> FilterOutput {
         let sigma = self.measurement_sigma(m);
+        // With a previous rejected measurement m0 at dt before: verge = m, rate = (m - m0)/dt,
+        // so var(rate) = (σ² + σ0²)/dt² and cov(verge, rate) = σ²/dt.
+        let (rate, rate_var, cov) = match self.last_rejected.take() {
+            Some((t0, m0)) if t_us > t0 => {
+                let dt = (t_us - t0) as f64 * 1e-6;
+                let sigma0 = self.measurement_sigma(m0);
+                (
+                    (m.verge_deg - m0.verge_deg) / dt,
+                    (sigma * sigma + sigma0 * sigma0) / (dt * dt),
+                    sigma * sigma / dt,
+                )
+            }
+            _ => (0.0, self.config.initial_rate_sigma.powi(2), 0.0),
+        };
         let s = State {
-            x: Vector2::new(m.verge_deg, 0.0),
-            p: Matrix2::new(
-                sigma * sigma,
-                0.0,
-                0.0,
-                self.config.initial_rate_sigma.powi(2),
-            ),
+            x: Vector2::new(m.verge_deg, rate),
+            p: Matrix2::new(sigma * sigma, cov, cov, rate_var),
             t_us,
         };
         self.state = Some(s);
         self.rejections = 0;
         FilterOutput {
             verge_deg: m.verge_deg,
-            rate_deg_s: 0.0,
+            rate_deg_s: rate,
             sigma_deg: sigma,
             status: FilterStatus::Restarted,
         }
@@ -237,6 +256,29 @@ mod tests {
             }
         }
         assert_eq!(status, FilterStatus::Restarted);
+    }
+
+    #[test]
+    fn a_move_that_starts_abruptly_is_followed_within_two_frames() {
+        let mut f = VergeFilter::new(KalmanConfig::default());
+        let truth = |i: u64| {
+            if i < 30 {
+                1.0
+            } else {
+                1.0 + 10.0 * (i - 30) as f64 / 30.0 // 10°/s from frame 30
+            }
+        };
+        let mut worst_after = 0f64;
+        for i in 0..60u64 {
+            let o = f.step(i * 33_333, meas(truth(i))).unwrap().unwrap();
+            if i >= 32 {
+                worst_after = worst_after.max((o.verge_deg - truth(i)).abs());
+            }
+            if i == 59 {
+                assert!((o.rate_deg_s - 10.0).abs() < 0.5, "{o:?}");
+            }
+        }
+        assert!(worst_after < 0.05, "error after the restart {worst_after}");
     }
 
     #[test]

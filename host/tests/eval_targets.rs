@@ -1,0 +1,72 @@
+//! The ground-truth targets, end to end (renderer → fabric model → wire → host → Kalman): on
+//! `road`, median |raw error| ≤ 0.01°, filtered max ≤ 0.05° and ≥ 95 % of frames estimated;
+//! on `sparse`, no estimate rather than a wrong number. Short sequences keep the test quick;
+//! `stereocal eval --scene road --frames 200 --seed S --json` checks the long form.
+
+use stereocal::eval::evaluate;
+use stereocal::record::FrameStatus;
+use stereocal::session::SessionConfig;
+use stereocal::summary::{Residual, RunCost, Summary};
+use stereocal::synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
+
+fn run(scene: SceneKind, trajectory: TrajectoryKind, frames: usize, seed: u64) -> Summary {
+    let config = SequenceConfig {
+        frames,
+        seed,
+        trajectory,
+        ..SequenceConfig::for_scene(scene)
+    };
+    let sequence = Sequence::builtin(scene, config).expect("sequence");
+    let (records, _) =
+        evaluate(&sequence, SessionConfig::default(), &mut |_| {}).expect("evaluation");
+    assert_eq!(records.len(), frames);
+    let cost = RunCost {
+        ms_per_frame_pair: 0.0,
+        wire_bytes_per_pair: 0.0,
+    };
+    Summary::from_records(&records, Residual::Keep, cost)
+}
+
+#[test]
+fn road_meets_the_accuracy_targets() {
+    for seed in [3, 11] {
+        let s = run(SceneKind::Road, TrajectoryKind::Fixed, 40, seed);
+        eprintln!("road seed {seed}: {s:?}");
+        assert!(s.estimated_fraction() >= 0.95, "seed {seed}: {s:?}");
+        assert!(s.median_abs_err_deg.unwrap() <= 0.01, "seed {seed}: {s:?}");
+        assert!(
+            s.filtered_max_abs_err_deg.unwrap() <= 0.05,
+            "seed {seed}: {s:?}"
+        );
+    }
+}
+
+#[test]
+fn moving_verge_is_tracked() {
+    let s = run(SceneKind::Road, TrajectoryKind::Manual, 60, 5);
+    assert!(s.estimated_fraction() >= 0.95, "{s:?}");
+    assert!(s.median_abs_err_deg.unwrap() <= 0.02, "{s:?}");
+}
+
+#[test]
+fn sparse_scene_gives_no_estimate_rather_than_a_wrong_number() {
+    let config = SequenceConfig {
+        frames: 8,
+        seed: 2,
+        ..SequenceConfig::for_scene(SceneKind::Sparse)
+    };
+    let sequence = Sequence::builtin(SceneKind::Sparse, config).expect("sequence");
+    let (records, _) =
+        evaluate(&sequence, SessionConfig::default(), &mut |_| {}).expect("evaluation");
+    for r in &records {
+        match r.status {
+            FrameStatus::NoEstimate => assert_eq!(r.raw_verge_deg, None),
+            // A frame that did estimate must still be right.
+            FrameStatus::Ok => {
+                let err = (r.raw_verge_deg.unwrap() - r.truth_deg.unwrap()).abs();
+                assert!(err <= 0.05, "frame {}: error {err}°", r.frame);
+            }
+            FrameStatus::Dropped => panic!("frame {} dropped without a drop rate", r.frame),
+        }
+    }
+}
