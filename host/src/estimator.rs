@@ -7,6 +7,8 @@
 //! starting point and a Cauchy-weighted Gauss-Newton refinement over all matches gives the
 //! answer and its uncertainty.
 
+use stereocal_hdl::regs::MAX_OCTAVES;
+
 use crate::calib::Calibration;
 use crate::descriptor::{describe, DescriptorConfig};
 use crate::essential::constrained::{self, VergeAngles};
@@ -117,6 +119,12 @@ pub struct FrameEstimate {
     pub inliers: usize,
     /// Robust residual scale in pixels (quality of the matches).
     pub residual_px: f64,
+    /// Left keypoints the fabric detected, by octave (index 0 = full resolution); empty when
+    /// estimated from pixel pairs. The thesis' fig. 5.3 "input data".
+    pub keypoints_per_octave: Vec<usize>,
+    /// The descriptor matches by the octave of their left keypoint; sums to `matches`, empty
+    /// when estimated from pixel pairs. Fig. 5.3 asks how much the coarse octaves contribute.
+    pub matches_per_octave: Vec<usize>,
 }
 
 /// The per-frame verge estimator.
@@ -190,6 +198,10 @@ impl VergeEstimator {
         }
         let mut est = self.estimate_from_pixels(&pairs)?;
         est.matches = matches.len();
+        let keypoints = left.keypoints();
+        est.keypoints_per_octave = per_octave(keypoints.iter().map(|k| k.octave));
+        est.matches_per_octave =
+            per_octave(matches.iter().map(|m| keypoints[m.left as usize].octave));
         Ok(est)
     }
 
@@ -230,6 +242,8 @@ impl VergeEstimator {
             used: pairs.len(),
             inliers: cfit.inlier_count(),
             residual_px: cfit.residual_sigma * focal,
+            keypoints_per_octave: Vec::new(),
+            matches_per_octave: Vec::new(),
         };
         if self.config.model == Model::General {
             // Two starts: the constrained solution (right when the head only verges) and the
@@ -268,6 +282,19 @@ impl VergeEstimator {
         }
         Ok(est)
     }
+}
+
+/// How many of `octaves` fall in each octave: at least the fabric's maximum octave count long,
+/// so frames line up, and longer if a frame carries a higher octave.
+fn per_octave(octaves: impl Iterator<Item = u8>) -> Vec<usize> {
+    let mut counts = vec![0; MAX_OCTAVES as usize];
+    for o in octaves.map(usize::from) {
+        if o >= counts.len() {
+            counts.resize(o + 1, 0);
+        }
+        counts[o] += 1;
+    }
+    counts
 }
 
 /// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]).

@@ -7,6 +7,7 @@
 use std::sync::mpsc;
 
 use crate::calib::{CalibError, Calibration};
+use crate::link::Device;
 use crate::record::FrameRecord;
 use crate::session::{Session, SessionConfig, SessionCost, SessionError};
 use crate::synth::{Sequence, StereoFrame, SynthError};
@@ -44,14 +45,7 @@ pub fn evaluate(
     progress: &mut dyn FnMut(&FrameRecord),
 ) -> Result<(Vec<FrameRecord>, SessionCost), EvalError> {
     let calib = sequence_calibration(sequence)?;
-    let (width, height) = sequence.image_size();
-    let size = |frame| EvalError::Size {
-        frame,
-        width,
-        height,
-    };
-    let w = u16::try_from(width).map_err(|_| size(0))?;
-    let h = u16::try_from(height).map_err(|_| size(0))?;
+    let (w, h) = fabric_size(sequence)?;
     let mut session = Session::new(calib, w, h, config)?;
     std::thread::scope(|scope| {
         let (tx, rx) = mpsc::sync_channel::<Result<StereoFrame, SynthError>>(LOOKAHEAD);
@@ -64,23 +58,51 @@ pub fn evaluate(
                 }
             }
         });
-        let mut records = Vec::with_capacity(sequence.len());
-        for frame in rx {
-            let frame = frame?;
-            let images = frame
-                .images
-                .as_ref()
-                .map(|i| (i.left.as_raw().as_slice(), i.right.as_raw().as_slice()));
-            let record = session.process(
-                frame.index,
-                images,
-                (width as usize, height as usize),
-                frame.timestamp_us,
-                Some(frame.truth.verge_deg),
-            )?;
-            progress(&record);
-            records.push(record);
-        }
+        let records = evaluate_frames(&mut session, sequence, rx, progress)?;
         Ok((records, session.cost()))
     })
+}
+
+/// The sequence's image size as the fabric's WIDTH and HEIGHT registers hold it.
+pub fn fabric_size(sequence: &Sequence) -> Result<(u16, u16), EvalError> {
+    let (width, height) = sequence.image_size();
+    let size = || EvalError::Size {
+        frame: 0,
+        width,
+        height,
+    };
+    Ok((
+        u16::try_from(width).map_err(|_| size())?,
+        u16::try_from(height).map_err(|_| size())?,
+    ))
+}
+
+/// Runs `frames` of `sequence` (rendered by the caller, in order) through `session`, on
+/// whatever device it has; `progress` is called after each frame. The session keeps its
+/// cost and its device, so the caller can stop the device and tell why a run failed.
+pub fn evaluate_frames<D: Device>(
+    session: &mut Session<D>,
+    sequence: &Sequence,
+    frames: impl IntoIterator<Item = Result<StereoFrame, SynthError>>,
+    progress: &mut dyn FnMut(&FrameRecord),
+) -> Result<Vec<FrameRecord>, EvalError> {
+    let (width, height) = sequence.image_size();
+    let mut records = Vec::with_capacity(sequence.len());
+    for frame in frames {
+        let frame = frame?;
+        let images = frame
+            .images
+            .as_ref()
+            .map(|i| (i.left.as_raw().as_slice(), i.right.as_raw().as_slice()));
+        let record = session.process(
+            frame.index,
+            images,
+            (width as usize, height as usize),
+            frame.timestamp_us,
+            Some(frame.truth.verge_deg),
+        )?;
+        progress(&record);
+        records.push(record);
+    }
+    Ok(records)
 }

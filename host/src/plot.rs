@@ -12,7 +12,9 @@ use crate::record::FrameRecord;
 
 /// The font is embedded so the figure has labels on a machine without fonts (see assets/).
 const FONT: &[u8] = include_bytes!("../assets/DejaVuSansMono.ttf");
-const FAMILY: &str = "sans-serif";
+/// The family name the embedded font is registered under; every figure of the crate draws
+/// its text with it (after [`ensure_font`]).
+pub(crate) const FAMILY: &str = "sans-serif";
 
 /// A figure that could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
@@ -22,7 +24,8 @@ pub struct PlotError {
     pub message: String,
 }
 
-fn ensure_font() {
+/// Registers the embedded font once per process.
+pub(crate) fn ensure_font() {
     static REGISTER: Once = Once::new();
     REGISTER.call_once(|| {
         // The bytes are a known-good TTF compiled into the binary; failure here is a build defect,
@@ -172,6 +175,8 @@ mod tests {
                     filtered_sigma_deg: ok.then_some(0.01),
                     matches: 30,
                     inliers: 28,
+                    keypoints_per_octave: Vec::new(),
+                    matches_per_octave: Vec::new(),
                     status: if ok {
                         FrameStatus::Ok
                     } else {

@@ -49,6 +49,10 @@ pub struct FrameRecord {
     pub matches: usize,
     /// Matches consistent with the estimated geometry.
     pub inliers: usize,
+    /// Left keypoints by octave (index 0 = full resolution), empty unless `status` is `Ok`.
+    pub keypoints_per_octave: Vec<usize>,
+    /// `matches` by the octave of the left keypoint, empty unless `status` is `Ok`.
+    pub matches_per_octave: Vec<usize>,
     pub status: FrameStatus,
     /// Ground-truth verge, when a truth file or the renderer gives it.
     pub truth_deg: Option<f64>,

@@ -107,7 +107,10 @@ pub fn summary_table(summary: &Summary, truth_known: bool, extras: &TableExtras)
         }
     }
     rows.extend([
-        ("filtered span".into(), deg(summary.filtered_span_deg)),
+        (
+            "filtered span (settled)".into(),
+            deg(summary.filtered_span_deg),
+        ),
         (
             "ms per frame pair".into(),
             format!("{:.2}", summary.ms_per_frame_pair),

@@ -68,6 +68,28 @@ pub enum SequenceError {
     },
 }
 
+impl GrayFrame {
+    /// The top-left `width` x `height` window (the origin stays, so the intrinsics still
+    /// hold); `None` when the window is larger than the frame.
+    pub fn cropped(&self, width: usize, height: usize) -> Option<GrayFrame> {
+        if width > self.width || height > self.height {
+            return None;
+        }
+        let pixels = self
+            .pixels
+            .chunks_exact(self.width)
+            .take(height)
+            .flat_map(|row| &row[..width])
+            .copied()
+            .collect();
+        Some(GrayFrame {
+            width,
+            height,
+            pixels,
+        })
+    }
+}
+
 /// Limits the fabric puts on the image size.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SizeLimits {

@@ -4,23 +4,20 @@
 //!
 //! `run`, `eval` and `demo` all go through here, so every number they print comes from the
 //! same path the bytes take on a real head: nothing reaches the estimator except through the
-//! wire format.
+//! wire format. The device is the in-process one unless [`Session::with_device`] is given
+//! another (`stereocal hil` gives it the firmware under QEMU).
 
 use std::time::{Duration, Instant};
 
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hdl::FabricConfig;
-use stereocal_wire::Camera;
 
 use crate::calib::Calibration;
 use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome};
 use crate::estimator::{EstimatorConfig, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
-use crate::link::{InProcessLink, LinkError};
+use crate::link::{Device, InProcessLink, LinkError};
 use crate::record::{FrameRecord, FrameStatus};
-
-/// How long the host waits for the device's answer to one request or one frame.
-const DEVICE_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// Settings of a session.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,6 +90,9 @@ pub struct SessionCost {
     pub pairs: usize,
     /// Wall time inside [`Session::process`] (device, driver, estimator, filter).
     pub elapsed: Duration,
+    /// The part of `elapsed` spent in the estimator (matching, RANSAC, refinement): the
+    /// device model dominates `elapsed`, so host-side choices such as RANSAC only show here.
+    pub estimating: Duration,
     /// Link bytes of the delivered pairs.
     pub wire_bytes: u64,
 }
@@ -106,6 +106,15 @@ impl SessionCost {
         }
     }
 
+    /// Estimator milliseconds per pair (see [`SessionCost::estimating`]).
+    pub fn estimator_ms_per_pair(&self) -> f64 {
+        if self.pairs == 0 {
+            0.0
+        } else {
+            self.estimating.as_secs_f64() * 1e3 / self.pairs as f64
+        }
+    }
+
     pub fn wire_bytes_per_pair(&self) -> f64 {
         if self.pairs == 0 {
             0.0
@@ -115,9 +124,9 @@ impl SessionCost {
     }
 }
 
-/// One stereo head, from pixels to filtered verge angle.
-pub struct Session {
-    driver: Driver<InProcessLink>,
+/// One stereo head, from pixels to filtered verge angle, on device `D`.
+pub struct Session<D: Device = InProcessLink> {
+    driver: Driver<D>,
     fabric: FabricConfig,
     estimator: VergeEstimator,
     filter: VergeFilter,
@@ -134,10 +143,25 @@ impl Session {
         height: u16,
         config: SessionConfig,
     ) -> Result<Self, SessionError> {
-        let mut driver = Driver::new(InProcessLink::new()?);
-        driver.hello(DEVICE_TIMEOUT)?;
+        Self::with_device(InProcessLink::new()?, calib, width, height, config)
+    }
+}
+
+impl<D: Device> Session<D> {
+    /// [`Session::new`] on `device`: says Hello, configures the fabric for `width` x
+    /// `height`, reads the registers back and enables the device.
+    pub fn with_device(
+        device: D,
+        calib: Calibration,
+        width: u16,
+        height: u16,
+        config: SessionConfig,
+    ) -> Result<Self, SessionError> {
+        let timeout = device.answer_timeout();
+        let mut driver = Driver::new(device);
+        driver.hello(timeout)?;
         let fabric = fabric_config(width, height, config.sobel_output);
-        driver.configure(&fabric, DEVICE_TIMEOUT)?;
+        driver.configure(&fabric, timeout)?;
         driver.enable()?;
         Ok(Self {
             driver,
@@ -178,6 +202,8 @@ impl Session {
             filtered_sigma_deg: None,
             matches: 0,
             inliers: 0,
+            keypoints_per_octave: Vec::new(),
+            matches_per_octave: Vec::new(),
             status: FrameStatus::Dropped,
             truth_deg,
         };
@@ -187,11 +213,9 @@ impl Session {
                 self.check_size(frame, image_size)?;
                 self.driver
                     .link_mut()
-                    .submit(Camera::Left, left, timestamp_us)?;
-                self.driver
-                    .link_mut()
-                    .submit(Camera::Right, right, timestamp_us)?;
-                let outcome = self.driver.next_pair(DEVICE_TIMEOUT)?;
+                    .submit_pair(left, right, timestamp_us)?;
+                let timeout = self.driver.link().answer_timeout();
+                let outcome = self.driver.next_pair(timeout)?;
                 self.check_step(frame, &outcome)?;
                 self.cost.wire_bytes += outcome.wire_bytes();
                 match outcome {
@@ -200,11 +224,16 @@ impl Session {
                         right: FrameOutcome::Delivered(right),
                     } => {
                         record.status = FrameStatus::NoEstimate;
-                        match self.estimator.estimate(&left.features, &right.features) {
+                        let estimating = Instant::now();
+                        let estimate = self.estimator.estimate(&left.features, &right.features);
+                        self.cost.estimating += estimating.elapsed();
+                        match estimate {
                             Ok(est) => {
                                 record.raw_verge_deg = Some(est.verge_deg);
                                 record.matches = est.matches;
                                 record.inliers = est.inliers;
+                                record.keypoints_per_octave = est.keypoints_per_octave;
+                                record.matches_per_octave = est.matches_per_octave;
                                 record.status = FrameStatus::Ok;
                                 Some(Measurement {
                                     verge_deg: est.verge_deg,

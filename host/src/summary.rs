@@ -4,6 +4,11 @@ use serde::Serialize;
 
 use crate::record::{FrameRecord, FrameStatus};
 
+/// Frames the filter takes to settle after it starts from one raw measurement. Over them its
+/// σ falls from the measurement's towards its steady value; their spread is the start-up, not
+/// the stability the span measures.
+pub const SETTLING_FRAMES: usize = 8;
+
 /// Whether a constant offset between estimate and truth is part of the error.
 ///
 /// Synthetic sequences know the verge exactly, so every degree of offset is an error. A real
@@ -30,7 +35,9 @@ pub struct Summary {
     pub dropped_frames: usize,
     /// The constant offset removed before the error statistics (0 when kept).
     pub residual_removed_deg: f64,
-    /// Peak-to-peak range of the filtered estimate (the thesis' fixed-camera "span").
+    /// Peak-to-peak range of the filtered estimate once the filter has settled: over the
+    /// frames after the first [`SETTLING_FRAMES`] (or the first eighth of a shorter run).
+    /// This is the thesis' fixed-camera "span" (fig. 5.2).
     pub filtered_span_deg: Option<f64>,
     /// Median number of ratio-test matches per estimated frame.
     pub median_matches: Option<f64>,
@@ -70,8 +77,10 @@ impl Summary {
             .iter()
             .filter_map(|r| Some((r.filtered_verge_deg? - r.truth_deg? - offset).abs()))
             .collect();
+        let settled_from = (records.len() / 8).min(SETTLING_FRAMES);
         let filtered: Vec<f64> = estimated
             .iter()
+            .filter(|r| r.frame >= settled_from)
             .filter_map(|r| r.filtered_verge_deg)
             .collect();
         let span = filtered
@@ -143,6 +152,8 @@ mod tests {
             filtered_sigma_deg: raw.map(|_| 0.01),
             matches: 100,
             inliers: 90,
+            keypoints_per_octave: Vec::new(),
+            matches_per_octave: Vec::new(),
             status,
             truth_deg: Some(truth),
         }
@@ -182,6 +193,17 @@ mod tests {
         assert!(removed.median_abs_err_deg.unwrap() < 1e-12);
         assert!((removed.max_abs_err_deg.unwrap() - 0.1).abs() < 1e-12);
         assert!((removed.filtered_span_deg.unwrap() - 2.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn span_leaves_out_the_filter_start_up() {
+        let mut records: Vec<FrameRecord> = (0..80)
+            .map(|i| rec(i, Some(1.0), 1.0, FrameStatus::Ok))
+            .collect();
+        records[SETTLING_FRAMES - 1].filtered_verge_deg = Some(1.5);
+        records[SETTLING_FRAMES + 3].filtered_verge_deg = Some(1.02);
+        let s = Summary::from_records(&records, Residual::Keep, COST);
+        assert!((s.filtered_span_deg.unwrap() - 0.02).abs() < 1e-12);
     }
 
     #[test]

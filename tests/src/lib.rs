@@ -1,1 +1,412 @@
-//! Hardware-in-the-loop simulation harness.
+//! Hardware-in-the-loop harness: the same frames and configuration through the in-process
+//! device and through the firmware ELF under `qemu-system-riscv32`, with the UART bytes and
+//! the host's estimates side by side.
+//!
+//! - **The emulator**: `qemu-system-riscv32` on `PATH` (Debian: `qemu-system-misc`). Without
+//!   it a test prints a loud `SKIPPED` line and passes, except under `CI=true`, where it
+//!   fails.
+//! - **The ELF**: every test binary first runs `cargo build --release -p stereocal-firmware
+//!   --target riscv32imc-unknown-none-elf` once (a no-op when it is up to date, so the ELF
+//!   never lags behind the in-process model it is compared with) and uses
+//!   `target/riscv32imc-unknown-none-elf/release/stereocal-firmware` (`CARGO_TARGET_DIR` is
+//!   honoured). `STEREOCAL_FIRMWARE_ELF` names another ELF and skips the build.
+//!
+//! The comparison ([`assert_same_stream`]): the firmware answers the host's `Hello` with the
+//! `LOG` capability added (it has a defmt logger; the in-process device does not). Every
+//! byte after that first link frame must be identical: register answers, every frame's
+//! packets, their sequence numbers and CRCs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use stereocal::calib::Calibration;
+use stereocal::eval::{fabric_size, sequence_calibration};
+use stereocal::hil::{run_on_qemu, HilError, QemuConfig, QemuRun, DEFAULT_QEMU};
+use stereocal::link::{Device, InProcessLink, Link, LinkError};
+use stereocal::record::FrameRecord;
+use stereocal::session::{Session, SessionConfig, SessionError};
+use stereocal::synth::{SceneKind, Sequence, SequenceConfig};
+use stereocal_wire::{decode, Capabilities, PacketRepr, DELIMITER};
+
+/// One stereo pair.
+#[derive(Debug, Clone)]
+pub struct Pair {
+    /// Capture time.
+    pub timestamp_us: u64,
+    /// Left image, raster order.
+    pub left: Vec<u8>,
+    /// Right image, raster order.
+    pub right: Vec<u8>,
+}
+
+/// Frames, calibration and host configuration of one comparison.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// For messages.
+    pub name: String,
+    /// The head's calibration.
+    pub calib: Calibration,
+    /// Image width.
+    pub width: u16,
+    /// Image height.
+    pub height: u16,
+    /// Host settings (estimator, Kalman, Sobel output mode).
+    pub config: SessionConfig,
+    /// The pairs, in order.
+    pub pairs: Vec<Pair>,
+}
+
+impl Scenario {
+    /// `frames` pairs of a built-in scene rendered at `width` x `height`.
+    pub fn synthetic(
+        scene: SceneKind,
+        width: u32,
+        height: u32,
+        frames: usize,
+        config: SessionConfig,
+    ) -> Self {
+        let sequence = Sequence::builtin(
+            scene,
+            SequenceConfig {
+                width,
+                height,
+                frames,
+                ..SequenceConfig::for_scene(scene)
+            },
+        )
+        .expect("built-in scene");
+        let (width, height) = fabric_size(&sequence).expect("image size fits the registers");
+        let pairs = (0..frames)
+            .map(|i| {
+                let frame = sequence.frame(i).expect("rendering");
+                let images = frame.images.expect("the scenes drop no frames by default");
+                Pair {
+                    timestamp_us: frame.timestamp_us,
+                    left: images.left.into_raw(),
+                    right: images.right.into_raw(),
+                }
+            })
+            .collect();
+        Self {
+            name: format!("{scene} {width}x{height}"),
+            calib: sequence_calibration(&sequence).expect("synthetic calibration"),
+            width,
+            height,
+            config,
+            pairs,
+        }
+    }
+
+    /// Runs the pairs on `device` through a host session; the records, one per pair.
+    pub fn run_session<D: Device>(&self, device: D) -> Result<Vec<FrameRecord>, SessionError> {
+        let mut session =
+            Session::with_device(device, self.calib, self.width, self.height, self.config)?;
+        let size = (usize::from(self.width), usize::from(self.height));
+        self.pairs
+            .iter()
+            .enumerate()
+            .map(|(i, p)| session.process(i, Some((&p.left, &p.right)), size, p.timestamp_us, None))
+            .collect()
+    }
+
+    /// The frames as the soft-core's frame-grabber input.
+    pub fn grabber_input(&self) -> stereocal::hil::GrabberInput {
+        let mut input = stereocal::hil::GrabberInput::new(self.width, self.height);
+        for p in &self.pairs {
+            input
+                .push_pair(&p.left, &p.right, p.timestamp_us)
+                .expect("the scenario fits the frame region");
+        }
+        input
+    }
+}
+
+/// What a run gave: the host's records and every byte the device sent.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// One record per pair.
+    pub records: Vec<FrameRecord>,
+    /// Device-to-host bytes.
+    pub bytes: Vec<u8>,
+    /// Wall time of the run.
+    pub seconds: f64,
+}
+
+/// A device whose received bytes are kept.
+struct Recorded<D> {
+    device: D,
+    bytes: Vec<u8>,
+}
+
+impl<D: Link> Link for Recorded<D> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        self.device.send(bytes)
+    }
+
+    fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
+        let n = self.device.recv(buf, deadline)?;
+        self.bytes.extend_from_slice(&buf[..n]);
+        Ok(n)
+    }
+}
+
+impl<D: Device> Device for Recorded<D> {
+    fn submit_pair(
+        &mut self,
+        left: &[u8],
+        right: &[u8],
+        timestamp_us: u64,
+    ) -> Result<(), LinkError> {
+        self.device.submit_pair(left, right, timestamp_us)
+    }
+
+    fn answer_timeout(&self) -> std::time::Duration {
+        self.device.answer_timeout()
+    }
+}
+
+/// The scenario on the in-process device (the fabric model's fast path, in this process).
+pub fn run_in_process(scenario: &Scenario) -> Outcome {
+    let start = Instant::now();
+    let mut device = Recorded {
+        device: InProcessLink::new().expect("in-process device"),
+        bytes: Vec::new(),
+    };
+    let records = scenario
+        .run_session(&mut device)
+        .unwrap_or_else(|e| panic!("{}: in-process run: {e}", scenario.name));
+    Outcome {
+        records,
+        bytes: device.bytes,
+        seconds: start.elapsed().as_secs_f64(),
+    }
+}
+
+/// The scenario on the firmware under QEMU.
+pub fn run_qemu(
+    scenario: &Scenario,
+    qemu: &QemuConfig,
+) -> Result<(Outcome, QemuRun<Vec<FrameRecord>>), HilError> {
+    let start = Instant::now();
+    let run = run_on_qemu(qemu, &scenario.grabber_input(), |device| {
+        Ok(scenario.run_session(device)?)
+    })?;
+    let outcome = Outcome {
+        records: run.value.clone(),
+        bytes: run.end.transcript.clone(),
+        seconds: start.elapsed().as_secs_f64(),
+    };
+    Ok((outcome, run))
+}
+
+/// Asserts that the firmware's UART bytes are the in-process device's bytes: the same
+/// `Hello` but for the `LOG` capability, then every byte the same.
+pub fn assert_same_stream(name: &str, qemu: &[u8], in_process: &[u8]) {
+    let (q_hello, q_rest) = split_first_frame(name, "QEMU", qemu);
+    let (i_hello, i_rest) = split_first_frame(name, "in-process", in_process);
+    let hello = |frame: &[u8], who: &str| {
+        let mut frame = frame.to_vec();
+        match decode(&mut frame) {
+            Ok((header, PacketRepr::Hello(hello))) => (header.seq, hello),
+            other => panic!("{name}: {who}: first packet is not a Hello: {other:?}"),
+        }
+    };
+    let (q_seq, q) = hello(q_hello, "QEMU");
+    let (i_seq, i) = hello(i_hello, "in-process");
+    assert_eq!(
+        (q_seq, q.version),
+        (i_seq, i.version),
+        "{name}: Hello header"
+    );
+    assert_eq!(
+        q.capabilities,
+        i.capabilities | Capabilities::LOG,
+        "{name}: the firmware's capabilities are the in-process device's plus LOG"
+    );
+    if q_rest != i_rest {
+        let at = q_rest
+            .iter()
+            .zip(i_rest)
+            .position(|(a, b)| a != b)
+            .unwrap_or(q_rest.len().min(i_rest.len()));
+        let frame = q_rest[..at].iter().filter(|&&b| b == DELIMITER).count();
+        panic!(
+            "{name}: the streams differ after the Hello at byte {at} (link frame {frame}): \
+             QEMU sent {} bytes, in-process {}",
+            q_rest.len(),
+            i_rest.len()
+        );
+    }
+}
+
+fn split_first_frame<'a>(name: &str, who: &str, bytes: &'a [u8]) -> (&'a [u8], &'a [u8]) {
+    let end = bytes
+        .iter()
+        .position(|&b| b == DELIMITER)
+        .unwrap_or_else(|| panic!("{name}: {who} sent no complete link frame"));
+    bytes.split_at(end + 1)
+}
+
+/// Whether the runs gave the same records, field by field (floats exactly).
+pub fn assert_same_records(name: &str, qemu: &[FrameRecord], in_process: &[FrameRecord]) {
+    assert_eq!(qemu.len(), in_process.len(), "{name}: record count");
+    for (q, i) in qemu.iter().zip(in_process) {
+        assert_eq!(q, i, "{name}: frame {} differs", i.frame);
+    }
+}
+
+/// The QEMU configuration for the tests, or `None` (after a loud `SKIPPED` line) when the
+/// emulator is not installed. Under `CI=true` a missing emulator is a failure.
+pub fn qemu_or_skip(test: &str) -> Option<QemuConfig> {
+    let found = Command::new(DEFAULT_QEMU)
+        .arg("--version")
+        .output()
+        .is_ok_and(|out| out.status.success());
+    if !found {
+        let reason = format!(
+            "{DEFAULT_QEMU} not found on PATH (Debian/Ubuntu: apt-get install qemu-system-misc)"
+        );
+        if std::env::var("CI").as_deref() == Ok("true") {
+            panic!("{test}: {reason}; required under CI=true");
+        }
+        skipped(test, &reason);
+        return None;
+    }
+    Some(QemuConfig::new(firmware_elf()))
+}
+
+/// The firmware ELF, built once per test binary (see the crate docs).
+pub fn firmware_elf() -> PathBuf {
+    static ELF: OnceLock<PathBuf> = OnceLock::new();
+    ELF.get_or_init(|| {
+        if let Some(elf) = std::env::var_os("STEREOCAL_FIRMWARE_ELF") {
+            return PathBuf::from(elf);
+        }
+        let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .parent()
+            .expect("tests/ sits in the workspace");
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let status = Command::new(cargo)
+            .current_dir(workspace)
+            .args(["build", "--release", "-p", "stereocal-firmware"])
+            .args(["--target", "riscv32imc-unknown-none-elf"])
+            .status()
+            .expect("cannot run cargo to build the firmware ELF");
+        assert!(status.success(), "building the firmware ELF failed");
+        std::env::var_os("CARGO_TARGET_DIR")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| workspace.join("target"))
+            .join("riscv32imc-unknown-none-elf/release/stereocal-firmware")
+    })
+    .clone()
+}
+
+/// `../shared/data/real` (or `STEREOCAL_REAL_DATA`), or `None` after a loud `SKIPPED` line
+/// when it is absent; under `CI=true` its absence is a failure.
+pub fn real_data_or_skip(test: &str) -> Option<PathBuf> {
+    let root = std::env::var_os("STEREOCAL_REAL_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/real"));
+    if root.join("eth3d_two_view").is_dir() {
+        return Some(root);
+    }
+    if std::env::var("CI").as_deref() == Ok("true") {
+        panic!(
+            "{test}: real data missing at {} (required under CI=true)",
+            root.display()
+        );
+    }
+    let reason = format!(
+        "real data not found at {} (set STEREOCAL_REAL_DATA)",
+        root.display()
+    );
+    skipped(test, &reason);
+    None
+}
+
+/// Says loudly that `test` did not run. Straight to stderr, past the test harness's output
+/// capture, so the line shows in a plain `cargo test` run.
+fn skipped(test: &str, reason: &str) {
+    use std::io::Write;
+    // A closed stderr has nobody to tell.
+    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED {test}: {reason} ***\n");
+}
+
+impl Scenario {
+    /// `frames` pairs cut from an ETH3D two-view pair (`root/eth3d_two_view/SCENE/im0.png`,
+    /// `im1.png`, `calib.txt`): a `width` x `height` window at (`x`, `y`) in both images,
+    /// moved `step` pixels right per frame, grey. The calibration is the window's at frame 0.
+    #[allow(clippy::too_many_arguments)]
+    pub fn real_crop(
+        root: &Path,
+        scene: &str,
+        (x, y): (u32, u32),
+        (width, height): (u16, u16),
+        step: u32,
+        frames: usize,
+        config: SessionConfig,
+    ) -> Self {
+        let dir = root.join("eth3d_two_view").join(scene);
+        let grey = |name: &str| {
+            let path = dir.join(name);
+            image::open(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .into_luma8()
+        };
+        let (left, right) = (grey("im0.png"), grey("im1.png"));
+        let crop = |img: &image::GrayImage, i: usize| {
+            let x = x + step * i as u32;
+            image::imageops::crop_imm(img, x, y, u32::from(width), u32::from(height))
+                .to_image()
+                .into_raw()
+        };
+        let pairs = (0..frames)
+            .map(|i| Pair {
+                timestamp_us: i as u64 * 33_333,
+                left: crop(&left, i),
+                right: crop(&right, i),
+            })
+            .collect();
+        let calib_path = dir.join("calib.txt");
+        let text = std::fs::read_to_string(&calib_path)
+            .unwrap_or_else(|e| panic!("{}: {e}", calib_path.display()));
+        let value = |key: &str| {
+            text.lines()
+                .find_map(|l| l.strip_prefix(key))
+                .unwrap_or_else(|| panic!("{}: no {key}", calib_path.display()))
+        };
+        // `cam0=[fx 0 cx; 0 fy cy; 0 0 1]`, baseline in millimetres.
+        let camera = |key: &str| {
+            let m: Vec<f64> = value(key)
+                .trim_matches(|c| c == '[' || c == ']')
+                .replace(';', " ")
+                .split_whitespace()
+                .map(|v| v.parse().expect("calib.txt number"))
+                .collect();
+            format!(
+                "fx = {}\nfy = {}\ncx = {}\ncy = {}\n",
+                m[0],
+                m[4],
+                m[2] - f64::from(x),
+                m[5] - f64::from(y)
+            )
+        };
+        let baseline_mm: f64 = value("baseline=").trim().parse().expect("baseline");
+        let toml = format!(
+            "baseline_m = {}\n[left]\n{}[right]\n{}",
+            baseline_mm / 1000.0,
+            camera("cam0="),
+            camera("cam1=")
+        );
+        Self {
+            name: format!("eth3d {scene} {width}x{height} crop"),
+            calib: Calibration::from_toml_str(&toml, &calib_path).expect("calibration"),
+            width,
+            height,
+            config,
+            pairs,
+        }
+    }
+}

@@ -1,13 +1,19 @@
 //! The soft-core program (`riscv32imc-unknown-none-elf`, QEMU `virt` machine).
 //!
 //! 1. Boot: check the frame-grabber input region (`softcore::frame_input`), program each
-//!    camera channel's WIDTH/HEIGHT from it, send `Hello`.
-//! 2. Unless the input asks to autostart, answer the host's packets (`Hello`, `RegisterRead`,
-//!    `RegisterWrite`; writes go to every channel, reads are answered from the left one) until
-//!    the host sets `CONTROL.ENABLE`.
+//!    camera channel's WIDTH/HEIGHT from it.
+//! 2. If the input asks to autostart, announce the device with `Hello` and start. Otherwise
+//!    answer the host's packets (`Hello`, `RegisterRead`, `RegisterWrite`; writes go to every
+//!    channel, reads are answered from the left one) until the host sets `CONTROL.ENABLE`.
+//!    The host speaks first there, so it gets one `Hello`, the answer to its own, and the
+//!    stream is byte for byte what the in-process device sends (apart from the `LOG`
+//!    capability bit in that `Hello`).
 //! 3. For every frame of the input, left then right image: the driver runs the image through
 //!    the fabric model and sends its packets. Host packets waiting between frames are
-//!    answered; clearing `CONTROL.ENABLE` pauses before the next frame.
+//!    answered; clearing `CONTROL.ENABLE` pauses before the next frame. With
+//!    `FLAG_COUNT_INSTRUCTIONS` each image's instruction counts follow as a log packet, and
+//!    after the last frame the row kernels' counts on the first image
+//!    (`softcore::instructions`).
 //! 4. Exit through the `sifive_test` finisher: 0 when every frame ran, 2 for a bad input
 //!    region, 3 when a frame failed (an `ErrorReport` says why), 101 on a panic.
 //!
@@ -32,9 +38,10 @@ mod soft_core {
     use stereocal_firmware::driver::{Driver, DriverError, FabricModel, PacketWriter};
     use stereocal_firmware::softcore::finisher::{self, ExitCode};
     use stereocal_firmware::softcore::frame_input::{
-        FrameInput, InputHeader, FLAG_AUTOSTART, FLAG_REGISTER_MODEL, VIRT_FRAME_REGION,
-        VIRT_FRAME_REGION_LEN,
+        FrameInput, InputHeader, FLAG_AUTOSTART, FLAG_COUNT_INSTRUCTIONS, FLAG_REGISTER_MODEL,
+        VIRT_FRAME_REGION, VIRT_FRAME_REGION_LEN,
     };
+    use stereocal_firmware::softcore::instructions::{self, CountedFrontEnd, InstructionReport};
     use stereocal_firmware::softcore::link::{Uart0, LINK};
     use stereocal_hdl::regs::{control, height, width};
     use stereocal_hdl::{RegisterBank, RegisterBus};
@@ -43,8 +50,9 @@ mod soft_core {
         PacketRepr, PROTOCOL_VERSION,
     };
 
-    /// One camera channel: the model's registers, the model, the driver.
-    type Channel = Driver<RegisterBank, FabricModel>;
+    /// One camera channel: the model's registers, the model (its computing counted in
+    /// instructions), the driver.
+    type Channel = Driver<RegisterBank, CountedFrontEnd<FabricModel>>;
 
     /// Host packets are short (a RegisterWrite is 16 framed bytes); a longer frame is refused.
     type HostAccumulator = Accumulator<64>;
@@ -74,11 +82,11 @@ mod soft_core {
 
     /// A channel for `camera` whose WIDTH/HEIGHT match the input frames.
     fn channel(header: &InputHeader, camera: Camera) -> Channel {
-        let model = if header.has_flag(FLAG_REGISTER_MODEL) {
+        let model = CountedFrontEnd::new(if header.has_flag(FLAG_REGISTER_MODEL) {
             FabricModel::register_level()
         } else {
             FabricModel::fast()
-        };
+        });
         let mut channel =
             Driver::new(RegisterBank::new(), model, camera).with_capabilities(Capabilities::LOG);
         let bus = channel.bus_mut();
@@ -161,7 +169,9 @@ mod soft_core {
             channel(&header, Camera::Right),
         ];
         let channels = &mut channels[..usize::from(header.cameras)];
-        send(&hello());
+        if header.has_flag(FLAG_AUTOSTART) {
+            send(&hello());
+        }
 
         let mut acc = HostAccumulator::new();
         let mut last_good_seq = 0;
@@ -173,23 +183,39 @@ mod soft_core {
                     // `FrameInput::new` checked that every image is in the region.
                     stop(ExitCode::BadInput);
                 };
-                let start = riscv::register::minstret::read64();
+                channel.fabric().take();
+                with_link(|link| link.sink_mut().take_waited());
+                let start = instructions::instret();
                 let result =
                     with_link(|link| channel.process_frame(image.pixels, image.timestamp_us, link));
-                let instructions = riscv::register::minstret::read64().wrapping_sub(start);
+                let spent = instructions::instret().wrapping_sub(start);
                 match result {
-                    Ok(summary) => defmt::info!(
-                        "frame {=u32} camera {=u8}: {=u32} points, {=u64} instructions",
-                        summary.frame_id,
-                        camera as u8,
-                        summary.points,
-                        instructions
-                    ),
+                    Ok(summary) if header.has_flag(FLAG_COUNT_INSTRUCTIONS) => {
+                        let front_end = channel.fabric().take();
+                        let uart_wait = with_link(|link| link.sink_mut().take_waited());
+                        instructions::log(&InstructionReport {
+                            frame: summary.frame_id,
+                            camera: camera as u8,
+                            pixels: image.pixels.len() as u32,
+                            front_end,
+                            driver: spent.wrapping_sub(front_end).wrapping_sub(uart_wait),
+                            uart_wait,
+                        })
+                    }
+                    Ok(_) => {}
                     Err(e) => {
                         failed = true;
                         report_frame_error(&e);
                     }
                 }
+            }
+        }
+        if header.has_flag(FLAG_COUNT_INSTRUCTIONS) {
+            let kernels = input
+                .image(0, 0)
+                .and_then(|image| instructions::measure_kernels(image.pixels, header.width.into()));
+            if let Some(report) = kernels {
+                instructions::log_kernels(&report);
             }
         }
         let dropped_logs = stereocal_firmware::softcore::dropped_logs();

@@ -19,7 +19,8 @@
 //! Pixels are 8-bit grey in raster order. `flags` bit 0 ([`FLAG_AUTOSTART`]) starts the run
 //! with the register reset values instead of waiting for the host to set `CONTROL.ENABLE`;
 //! bit 1 ([`FLAG_REGISTER_MODEL`]) runs the register-level fabric model instead of the fast
-//! path. Other bits must be 0.
+//! path; bit 2 ([`FLAG_COUNT_INSTRUCTIONS`]) reports every image's instruction counts in a
+//! `Log` packet. Other bits must be 0.
 
 /// Start of the input region on the QEMU `virt` machine (16 MiB into DRAM, above the
 /// program; see `firmware/memory.x`).
@@ -39,7 +40,11 @@ pub const IMAGE_HEADER_LEN: usize = 8;
 pub const FLAG_AUTOSTART: u16 = 1 << 0;
 /// Use the register-level fabric model instead of the fast path.
 pub const FLAG_REGISTER_MODEL: u16 = 1 << 1;
-const KNOWN_FLAGS: u16 = FLAG_AUTOSTART | FLAG_REGISTER_MODEL;
+/// After every image, log the instructions it took (`minstret`; instructions only under
+/// QEMU's `-icount`) in the front end and in the whole frame. Off by default: the log packets
+/// take sequence numbers, so a run with them is not byte-identical to the in-process device.
+pub const FLAG_COUNT_INSTRUCTIONS: u16 = 1 << 2;
+const KNOWN_FLAGS: u16 = FLAG_AUTOSTART | FLAG_REGISTER_MODEL | FLAG_COUNT_INSTRUCTIONS;
 
 /// What is wrong with an input region.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -2,8 +2,9 @@
 //! input region, and on the bare-metal target the link writer, the defmt logger and the panic
 //! handler.
 //!
-//! `uart`, `finisher` and `frame_input` build everywhere (the host writes frame-input files
-//! with [`frame_input::InputHeader::emit`] and tests the parser); the rest only exists on
+//! `uart`, `finisher`, `frame_input` and `instructions` build everywhere (the host writes
+//! frame-input files with [`frame_input::InputHeader::emit`] and reads instruction reports
+//! with [`instructions::InstructionReport::parse`]); the rest only exists on
 //! `target_os = "none"`, where it is linked into the ELF.
 //!
 //! # Running the ELF under QEMU
@@ -17,20 +18,24 @@
 //! ```
 //! The UART is the link, raw bytes both ways: use a socket, `stdio` (with `signal=off`) or a
 //! `file:` chardev, never `-nographic` (its monitor multiplexer eats `0x01` bytes).
-//! `frames.bin` is the frame-grabber input ([`frame_input`]). The firmware sends `Hello`,
-//! then answers `Hello` / `RegisterRead` / `RegisterWrite` until the host writes
-//! `CONTROL.ENABLE = 1` (or at once if the input has [`frame_input::FLAG_AUTOSTART`]), then
-//! sends every frame's packets and exits: status 0 when every frame ran, 2 for a bad input
-//! region, 3 when a frame failed (an `ErrorReport` said why), 101 on a panic (a defmt `Log`
+//! `frames.bin` is the frame-grabber input ([`frame_input`]). The firmware answers `Hello` /
+//! `RegisterRead` / `RegisterWrite` until the host writes `CONTROL.ENABLE = 1`; with
+//! [`frame_input::FLAG_AUTOSTART`] (no host to ask) it announces itself with a `Hello` and
+//! starts at once (a host that asked first gets exactly one `Hello`, as from the in-process
+//! device, so the two byte streams stay comparable). Then it sends every frame's packets and
+//! exits: status 0 when every frame ran, 2 for a bad input region (after a `Hello` and a log
+//! saying why), 3 when a frame failed (an `ErrorReport` said why), 101 on a panic (a defmt `Log`
 //! packet carries the message). The host may send more packets between frames; they are read
 //! when the current frame is done (QEMU holds them back meanwhile; a real UART would need the
 //! host to wait for `FrameEnd`).
 //!
-//! Instructions per frame: build with `DEFMT_LOG=info` and run with `-icount shift=0`; each
-//! frame then logs its `minstret` delta (which counts instructions under `-icount`).
+//! Instructions per frame: set [`frame_input::FLAG_COUNT_INSTRUCTIONS`] and run with
+//! `-icount shift=0`; each image then logs its `minstret` deltas ([`instructions`]).
+//! `stereocal hil --count-instructions` does both.
 
 pub mod finisher;
 pub mod frame_input;
+pub mod instructions;
 pub mod uart;
 
 #[cfg(target_os = "none")]

@@ -62,9 +62,14 @@ impl Ns16550 {
         self.write_reg(LCR, LCR_8N1);
     }
 
+    /// Whether the transmitter can take a byte now.
+    pub fn ready_to_send(&self) -> bool {
+        self.read_reg(LSR) & LSR_THR_EMPTY != 0
+    }
+
     /// Sends one byte, waiting until the transmitter can take it.
     pub fn write_byte(&mut self, byte: u8) {
-        while self.read_reg(LSR) & LSR_THR_EMPTY == 0 {
+        while !self.ready_to_send() {
             core::hint::spin_loop();
         }
         self.write_reg(RBR_THR, byte);

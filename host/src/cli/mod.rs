@@ -1,5 +1,8 @@
 //! The `stereocal` command line (the contract is in the architecture document).
 
+mod experiment;
+mod hil;
+mod inject;
 mod options;
 mod output;
 mod real;
@@ -25,6 +28,12 @@ enum Command {
     Eval(synthetic::EvalArgs),
     /// Write a rendered sequence (images, calib.toml, truth.csv) to a directory.
     Synth(synthetic::SynthArgs),
+    /// The `eval` run with the firmware ELF on the emulated soft-core (QEMU).
+    Hil(hil::HilArgs),
+    /// Turn a real rectified pair into a sequence with an exactly injected verge per frame.
+    Inject(inject::InjectArgs),
+    /// Reproduce one of the thesis' experiments (or all) as CSV tables and PNG figures.
+    Experiment(experiment::ExperimentArgs),
 }
 
 impl Cli {
@@ -34,6 +43,9 @@ impl Cli {
             Command::Run(a) => real::run(a),
             Command::Eval(a) => synthetic::eval(a),
             Command::Synth(a) => synthetic::synth(a),
+            Command::Hil(a) => hil::hil(a),
+            Command::Inject(a) => inject::inject(a),
+            Command::Experiment(a) => experiment::experiment(a),
         }
     }
 }

@@ -8,7 +8,7 @@ use clap::Args;
 use stereocal::calib::Calibration;
 use stereocal::record::FrameRecord;
 use stereocal::sequence::{GrayFrame, SizeLimits, StereoSequence};
-use stereocal::session::Session;
+use stereocal::session::{fabric_config, Session};
 use stereocal::summary::{Residual, RunCost, Summary};
 use stereocal::verge_csv::read_truth_csv;
 use stereocal_hdl::regs::{MAX_HEIGHT, MAX_WIDTH, MIN_SIDE};
@@ -77,13 +77,20 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         first.width,
         first.height
     );
-    let mut session = Session::new(
-        calib,
-        first.width as u16,
-        first.height as u16,
-        args.estimate.session_config(),
-    )
-    .context("cannot start the device")?;
+    // Every octave must have whole pixels, so the fabric's window is a multiple of
+    // 2^(octaves-1) on each side; like a grabber's region of interest it starts at the
+    // top-left corner, which keeps the intrinsics valid.
+    let config = args.estimate.session_config();
+    let step = 1usize << (fabric_config(16, 16, config.sobel_output).octaves - 1);
+    let window = (size.0 / step * step, size.1 / step * step);
+    if window != size {
+        eprintln!(
+            "note: the fabric takes {}x{} windows of these {}x{} images (sides must be multiples of {step})",
+            window.0, window.1, size.0, size.1
+        );
+    }
+    let mut session = Session::new(calib, window.0 as u16, window.1 as u16, config)
+        .context("cannot start the device")?;
 
     let bar = progress_bar(sequence.len() as u64, "estimating");
     let period_us = 1e6 / args.fps;
@@ -94,7 +101,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             for frame in 0..sequence.len() {
                 let pair = sequence
                     .pair(frame, Some(size))
-                    .map_err(anyhow::Error::from);
+                    .map_err(anyhow::Error::from)
+                    .and_then(|(l, r)| {
+                        l.cropped(window.0, window.1)
+                            .zip(r.cropped(window.0, window.1))
+                            .context("window larger than the frame")
+                    });
                 let stop = pair.is_err();
                 if tx.send(pair).is_err() || stop {
                     break;
@@ -107,7 +119,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             let record = session.process(
                 frame,
                 Some((&l.pixels, &r.pixels)),
-                size,
+                window,
                 (frame as f64 * period_us).round() as u64,
                 truth.as_ref().map(|t| t[frame]),
             )?;
@@ -131,7 +143,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         &records,
         &summary,
         truth.is_some(),
-        (size.0 as u32, size.1 as u32),
+        (window.0 as u32, window.1 as u32),
         Finish {
             out: Some(&args.out),
             json: args.json,

@@ -13,7 +13,11 @@
 //! | TCP (QEMU `-chardev socket,host=..,port=..`) | [`TcpLink`] | [`StreamLink::tcp`] |
 //! | Unix socket (QEMU `-chardev socket,path=..`) | [`UnixLink`] | [`StreamLink::unix`] |
 //! | a byte capture played back | [`ReplayLink`] | [`ReplayLink::new`], [`ReplayLink::from_file`] |
+//! | the firmware ELF under `qemu-system-riscv32` | [`QemuDevice`](crate::hil::QemuDevice) | [`QemuDevice::start`](crate::hil::QemuDevice::start) |
+//!
+//! A link that also takes camera frames is a [`Device`]: what a session runs on.
 
+mod device;
 mod error;
 mod in_process;
 mod replay;
@@ -25,6 +29,7 @@ mod unix;
 
 use std::time::Instant;
 
+pub use device::Device;
 pub use error::LinkError;
 pub use in_process::InProcessLink;
 pub use replay::ReplayLink;

@@ -6,6 +6,7 @@
 //! driven along a road. Projection and occlusion are exact; only the pixel integration is
 //! sampled (see `render.rs`), so the truth it reports is the truth in the pixels.
 pub mod inject;
+pub mod injected;
 
 mod camera;
 mod layout;

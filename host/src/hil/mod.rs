@@ -1,0 +1,22 @@
+//! Hardware in the loop: the firmware ELF on an emulated RISC-V soft-core (QEMU `virt`),
+//! speaking the wire format to the same host driver, session and estimator as the in-process
+//! device.
+//!
+//! The frames go into the soft-core's frame-grabber region before it boots ([`GrabberInput`];
+//! the emulated UART is far too slow for pixels); the configuration, the packets and the
+//! firmware's defmt logs go over the UART, which QEMU puts on a Unix socket
+//! ([`QemuDevice`]). [`run_on_qemu`] runs any session on it and stops QEMU on every path;
+//! [`run_sequence`] is `stereocal hil`. The `stereocal-hil` tests check that the UART bytes
+//! are the in-process device's bytes and the estimates the same numbers.
+
+mod device_log;
+mod error;
+mod input;
+mod qemu;
+mod run;
+
+pub use device_log::{instruction_reports, kernel_report, DeviceLog, LogDecoder};
+pub use error::{FirmwareExit, HilError, TimeoutKind};
+pub use input::GrabberInput;
+pub use qemu::{QemuConfig, QemuDevice, QemuEnd, QemuTimeouts, DEFAULT_QEMU};
+pub use run::{run_on_qemu, run_sequence, QemuRun};

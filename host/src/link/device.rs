@@ -1,0 +1,65 @@
+//! A link whose far end takes camera frames: what a [`Session`](crate::session::Session) runs
+//! on.
+//!
+//! The in-process device gets its pixels through a call; the firmware under QEMU got them
+//! in its frame-grabber region before it booted. A session does not care which: it hands
+//! every pair to [`Device::submit_pair`] and reads the packets back over the link.
+
+use std::time::Duration;
+
+use stereocal_wire::Camera;
+
+use super::{InProcessLink, Link, LinkError};
+
+/// How long the host waits for the in-process device's answer to one request or one frame.
+/// It answers synchronously, so this only bounds a device that has nothing to send.
+const IN_PROCESS_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// A [`Link`] to a stereo front end.
+pub trait Device: Link {
+    /// Delivers a stereo pair (raster order, 8-bit grey, the configured size) captured at
+    /// `timestamp_us`; its packets arrive over the link, left camera first.
+    fn submit_pair(
+        &mut self,
+        left: &[u8],
+        right: &[u8],
+        timestamp_us: u64,
+    ) -> Result<(), LinkError>;
+
+    /// How long the host waits for one answer or one frame pair from this device.
+    fn answer_timeout(&self) -> Duration;
+}
+
+/// A borrowed device is a device: the caller keeps it, e.g. to stop an emulator and read its
+/// exit status after a session on it failed.
+impl<D: Device + ?Sized> Device for &mut D {
+    fn submit_pair(
+        &mut self,
+        left: &[u8],
+        right: &[u8],
+        timestamp_us: u64,
+    ) -> Result<(), LinkError> {
+        (**self).submit_pair(left, right, timestamp_us)
+    }
+
+    fn answer_timeout(&self) -> Duration {
+        (**self).answer_timeout()
+    }
+}
+
+impl Device for InProcessLink {
+    fn submit_pair(
+        &mut self,
+        left: &[u8],
+        right: &[u8],
+        timestamp_us: u64,
+    ) -> Result<(), LinkError> {
+        self.submit(Camera::Left, left, timestamp_us)?;
+        self.submit(Camera::Right, right, timestamp_us)?;
+        Ok(())
+    }
+
+    fn answer_timeout(&self) -> Duration {
+        IN_PROCESS_TIMEOUT
+    }
+}
