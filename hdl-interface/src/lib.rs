@@ -3,8 +3,12 @@
 //!
 //! - [`regs`] is generated from `hdl-interface/regmap.toml` by `cargo regen`: offsets, field
 //!   positions, reset values, enums, parameters and stream-port layouts.
-//! - [`RegisterBus`] is how a driver talks to the fabric; [`Mmio`] implements it on the
-//!   soft-core, [`RegisterBank`] in memory for the fabric model and for tests.
+//! - [`Registers`] ([`regs_api`]), also generated, is the typed register interface: one
+//!   getter/setter per field, following the field's access type, range and enum. It is
+//!   implemented for every [`RegisterBus`].
+//! - [`RegisterBus`] (hand-written) is the transport under it, 32-bit reads and writes at
+//!   byte offsets; [`Mmio`] implements it on the soft-core, [`RegisterBank`] in memory for the
+//!   fabric model and for tests.
 //! - [`FabricConfig`] is the typed, validated configuration the driver writes and the model
 //!   reads.
 #![no_std]
@@ -21,6 +25,8 @@ mod register;
 // Generated; rustfmt would only fight the generator.
 #[rustfmt::skip]
 pub mod regs;
+#[rustfmt::skip]
+pub mod regs_api;
 
 pub use access::Access;
 pub use bank::RegisterBank;
@@ -31,3 +37,4 @@ pub use error::Error;
 pub use field::Field;
 pub use mmio::Mmio;
 pub use register::{register_at, Register};
+pub use regs_api::Registers;

@@ -8,6 +8,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use serde::Deserialize;
 
+use crate::emit::rust_api;
 use crate::error::RegenError;
 
 /// Access type of a register field, as seen from the bus.
@@ -479,6 +480,39 @@ fn check_generated_names(d: &Description) -> Result<(), RegenError> {
             }
         }
     }
+    // The typed trait of `regs_api.rs`: its methods share the trait's namespace with the
+    // `RegisterBus` methods it builds on; the words of `pops_on_read` registers are types next
+    // to it, each with an accessor per field.
+    let api = rust_api::TRAIT_NAME;
+    claim("regs_api::", api.to_string(), "block".to_string())?;
+    for name in ["read", "write", "read_field", "write_field"] {
+        claim(
+            &format!("{api}::"),
+            name.to_string(),
+            "RegisterBus".to_string(),
+        )?;
+    }
+    for r in &d.registers {
+        let origin = format!("register {}", r.name);
+        check_rust_identifier(&origin, &r.name.to_ascii_lowercase())?;
+        if let Some(pop) = rust_api::pop_method(r) {
+            claim(&format!("{api}::"), pop, origin.clone())?;
+        }
+        if let Some((ty, accessors)) = rust_api::word_type(r) {
+            claim("regs_api::", ty.clone(), origin.clone())?;
+            for (f, accessor) in r.fields.iter().zip(accessors) {
+                let forigin = format!("{origin} field {}", f.name);
+                check_rust_identifier(&forigin, &accessor)?;
+                claim(&format!("regs_api::{ty}::"), accessor, forigin)?;
+            }
+        }
+        for f in &r.fields {
+            let forigin = format!("{origin} field {}", f.name);
+            for (_, name) in rust_api::field_methods(r, f) {
+                claim(&format!("{api}::"), name, forigin.clone())?;
+            }
+        }
+    }
     for p in &d.ports {
         let origin = format!("port {}", p.name);
         let module = format!("ports::{}::", p.name);
@@ -505,6 +539,24 @@ fn check_generated_names(d: &Description) -> Result<(), RegenError> {
                 )?;
             }
         }
+    }
+    Ok(())
+}
+
+/// Lower-case names become Rust modules and methods, where a keyword does not compile.
+fn check_rust_identifier(at: &str, name: &str) -> Result<(), RegenError> {
+    const KEYWORDS: [&str; 51] = [
+        "abstract", "as", "async", "await", "become", "box", "break", "const", "continue", "crate",
+        "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if", "impl",
+        "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub",
+        "ref", "return", "self", "static", "struct", "super", "trait", "true", "try", "type",
+        "typeof", "union", "unsafe", "unsized", "use", "virtual", "where", "while",
+    ];
+    if KEYWORDS.contains(&name) {
+        return Err(invalid(
+            at,
+            format!("generates the Rust identifier `{name}`, which is a keyword"),
+        ));
     }
     Ok(())
 }
@@ -893,6 +945,40 @@ doc = "x"
         let split = MINIMAL.replace("name = \"WIDTH\"", "name = \"VERSION_MAJOR\"");
         let e = error_of(&split);
         assert!(e.contains("VERSION_MAJOR"), "{e}");
+    }
+
+    #[test]
+    fn colliding_trait_methods_are_rejected() {
+        // Register SET_WIDTH field VALUE has the getter `set_width_value`, which is also
+        // WIDTH.VALUE's setter.
+        let extra = r#"
+[[register]]
+name = "SET_WIDTH"
+offset = 8
+access = "ro"
+reset = 0
+doc = "s"
+[[register.field]]
+name = "VALUE"
+bits = [0, 0]
+reset = 0
+doc = "v"
+"#;
+        let e = error_of(&format!("{MINIMAL}{extra}"));
+        assert!(e.contains("`set_width_value`"), "{e}");
+        // A getter named like a `RegisterBus` method.
+        let e = error_of(
+            &MINIMAL
+                .replace("name = \"WIDTH\"", "name = \"READ\"")
+                .replace("name = \"VALUE\"", "name = \"FIELD\""),
+        );
+        assert!(e.contains("`read_field`"), "{e}");
+    }
+
+    #[test]
+    fn keywords_are_rejected_as_rust_names() {
+        let e = error_of(&MINIMAL.replace("name = \"WIDTH\"", "name = \"LOOP\""));
+        assert!(e.contains("`loop`") && e.contains("keyword"), "{e}");
     }
 
     #[test]

@@ -1,9 +1,10 @@
 //! Generator of the stereocal register-map artefacts.
 //!
 //! `hdl-interface/regmap.toml` is the one description of the fabric's registers and stream
-//! ports. [`generate`] turns it into the Rust module, C header, Verilog include and Markdown
-//! table, all in memory, so the `cargo regen` binary and the staleness test share one code
-//! path: the test cannot pass on output the binary would not write.
+//! ports. [`generate`] turns it into the Rust tables (`src/regs.rs`), the typed Rust register
+//! trait (`src/regs_api.rs`), the C header, the Verilog include and the Markdown table, all in
+//! memory, so the `cargo regen` binary and the staleness test share one code path: the test
+//! cannot pass on output the binary would not write.
 
 pub mod description;
 mod emit;
@@ -28,6 +29,7 @@ pub struct Output {
 
 /// Paths of the outputs, relative to `hdl-interface/`.
 pub const RUST_PATH: &str = "src/regs.rs";
+pub const RUST_API_PATH: &str = "src/regs_api.rs";
 pub const C_PATH: &str = "generated/stereocal_regs.h";
 pub const VERILOG_PATH: &str = "generated/stereocal_regs.vh";
 pub const MARKDOWN_PATH: &str = "generated/registers.md";
@@ -39,6 +41,10 @@ pub fn generate(source: &str) -> Result<Vec<Output>, RegenError> {
         Output {
             path: RUST_PATH,
             contents: emit::rust::emit(&d),
+        },
+        Output {
+            path: RUST_API_PATH,
+            contents: emit::rust_api::emit(&d),
         },
         Output {
             path: C_PATH,

@@ -28,3 +28,22 @@ fn every_output_carries_the_banner() {
         );
     }
 }
+
+#[test]
+fn every_committed_output_is_checked() {
+    use stereocal_hdl_regen::{C_PATH, MARKDOWN_PATH, RUST_API_PATH, RUST_PATH, VERILOG_PATH};
+    let source = read_description(&hdl_interface_dir()).unwrap_or_else(|e| panic!("{e}"));
+    let outputs = generate(&source).unwrap_or_else(|e| panic!("{e}"));
+    let paths: Vec<&str> = outputs.iter().map(|o| o.path).collect();
+    assert_eq!(
+        paths,
+        [
+            RUST_PATH,
+            RUST_API_PATH,
+            C_PATH,
+            VERILOG_PATH,
+            MARKDOWN_PATH
+        ],
+        "the staleness check covers exactly these files"
+    );
+}

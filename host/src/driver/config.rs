@@ -4,6 +4,8 @@
 //! against an in-memory [`RegisterBank`] that records the bus writes turns it into wire
 //! `RegisterWrite` packets without restating the register map, and the bank's read-back
 //! (with the map's access rules: reserved bits read 0) is what the device must answer.
+//! [`writes`] does the same for any other register operation, such as the generated
+//! [`stereocal_hdl::Registers`] setters.
 
 use stereocal_hdl::{Error, FabricConfig, RegisterBank, RegisterBus};
 
@@ -30,12 +32,28 @@ impl RegisterBus for Recorder {
     }
 }
 
+impl Recorder {
+    fn new() -> Self {
+        Self {
+            bank: RegisterBank::new(),
+            writes: Vec::new(),
+        }
+    }
+}
+
+/// The register writes `op` makes on a bus whose registers are at their reset values, in
+/// order, as the device must receive them.
+pub(crate) fn writes(
+    op: impl FnOnce(&mut dyn RegisterBus) -> Result<(), Error>,
+) -> Result<Vec<(u16, u32)>, Error> {
+    let mut recorder = Recorder::new();
+    op(&mut recorder)?;
+    Ok(recorder.writes)
+}
+
 /// The writes `config` needs, validated first.
 pub(crate) fn plan(config: &FabricConfig) -> Result<Plan, Error> {
-    let mut recorder = Recorder {
-        bank: RegisterBank::new(),
-        writes: Vec::new(),
-    };
+    let mut recorder = Recorder::new();
     config.write_to(&mut recorder)?;
     let mut read_back: Vec<(u16, u32)> = Vec::new();
     for &(addr, _) in &recorder.writes {
@@ -82,6 +100,13 @@ mod tests {
         assert!(plan
             .read_back
             .contains(&(regs::output_mode::OFFSET, 2 << 4)));
+    }
+
+    #[test]
+    fn enabling_is_one_write_of_control_enable() {
+        use stereocal_hdl::Registers;
+        let enable = writes(|bus| bus.set_control_enable(true)).unwrap();
+        assert_eq!(enable, [(regs::control::OFFSET, 1)]);
     }
 
     #[test]

@@ -33,7 +33,7 @@ mod stats;
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-use stereocal_hdl::{regs, FabricConfig};
+use stereocal_hdl::{FabricConfig, Registers};
 use stereocal_wire::{
     encode, Accumulator, Camera, ErrorReportRepr, FeedResult, HelloRepr, PacketRepr,
     RegisterReadRepr, RegisterWriteRepr, MAX_FRAME_LEN, PROTOCOL_VERSION,
@@ -262,10 +262,12 @@ impl<L: Link> Driver<L> {
 
     /// Sets `CONTROL.ENABLE`: the device starts taking frames.
     pub fn enable(&mut self) -> Result<(), DriverError> {
-        let value = regs::control::ENABLE
-            .insert(0, 1)
-            .map_err(DriverError::Config)?;
-        self.write_register(regs::control::OFFSET, value)
+        let writes =
+            config::writes(|bus| bus.set_control_enable(true)).map_err(DriverError::Config)?;
+        for (addr, value) in writes {
+            self.write_register(addr, value)?;
+        }
+        Ok(())
     }
 
     /// The next camera frame, delivered or damaged.

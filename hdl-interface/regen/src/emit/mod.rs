@@ -3,6 +3,7 @@
 pub mod c;
 pub mod markdown;
 pub mod rust;
+pub mod rust_api;
 pub mod verilog;
 
 /// `0x4000_0000`-style hex with 16-bit groups, as Rust and the docs spell 32-bit words.

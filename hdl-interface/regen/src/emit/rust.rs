@@ -15,7 +15,7 @@ fn access_variant(a: Access) -> &'static str {
     }
 }
 
-fn doc_lines(out: &mut String, indent: &str, text: &str) {
+pub(super) fn doc_lines(out: &mut String, indent: &str, text: &str) {
     for line in text.lines() {
         if line.is_empty() {
             let _ = writeln!(out, "{indent}///");
