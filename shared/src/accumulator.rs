@@ -1,5 +1,7 @@
 //! A streaming receiver: bytes in, decoded packets out, at any chunking of the input.
 
+use heapless::Vec;
+
 use crate::frame::{decode, DELIMITER};
 use crate::packet::header::Header;
 use crate::packet_repr::PacketRepr;
@@ -17,8 +19,11 @@ use crate::Error;
 /// lone `0x00` to flush a receiver's partial frame.
 #[derive(Debug, Clone)]
 pub struct Accumulator<const N: usize> {
-    buf: [u8; N],
-    len: usize,
+    /// The COBS bytes of the frame being received.
+    buf: Vec<u8, N>,
+    /// `buf` holds a frame that was handed out (decoded in place, borrowed by the last
+    /// [`FeedResult`]); the next call empties it first.
+    delivered: bool,
     /// Skipping the rest of an over-long frame.
     discarding: bool,
 }
@@ -52,15 +57,16 @@ impl<const N: usize> Accumulator<N> {
     /// An empty accumulator.
     pub const fn new() -> Self {
         Accumulator {
-            buf: [0; N],
-            len: 0,
+            buf: Vec::new(),
+            delivered: false,
             discarding: false,
         }
     }
 
     /// Drops any partial frame (e.g. after reopening the link).
     pub fn reset(&mut self) {
-        self.len = 0;
+        self.buf.clear();
+        self.delivered = false;
         self.discarding = false;
     }
 
@@ -68,6 +74,10 @@ impl<const N: usize> Accumulator<N> {
     /// reports what happened; call again with the remaining input until [`FeedResult::Consumed`].
     /// Never panics, whatever the input.
     pub fn feed<'de, 'a>(&'de mut self, input: &'a [u8]) -> FeedResult<'de, 'a> {
+        if self.delivered {
+            self.buf.clear();
+            self.delivered = false;
+        }
         let mut input = input;
         loop {
             let (chunk, delimited, rest) = match input.iter().position(|&byte| byte == DELIMITER) {
@@ -82,24 +92,21 @@ impl<const N: usize> Accumulator<N> {
                 input = rest;
                 continue;
             }
-            let room = N - self.len;
-            if chunk.len() > room {
-                self.len = 0;
+            if self.buf.extend_from_slice(chunk).is_err() {
+                // Nothing was copied: the chunk does not fit in what is left of the buffer.
+                self.buf.clear();
                 self.discarding = !delimited;
                 return FeedResult::OverFull(rest);
             }
-            self.buf[self.len..self.len + chunk.len()].copy_from_slice(chunk);
-            self.len += chunk.len();
             if !delimited {
                 return FeedResult::Consumed;
             }
-            let frame_len = self.len;
-            self.len = 0;
-            if frame_len == 0 {
+            if self.buf.is_empty() {
                 input = rest;
                 continue;
             }
-            return match decode(&mut self.buf[..frame_len]) {
+            self.delivered = true;
+            return match decode(&mut self.buf) {
                 Ok((header, packet)) => FeedResult::Success {
                     header,
                     packet,

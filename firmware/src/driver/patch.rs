@@ -6,6 +6,7 @@
 //! for the rows below it. A point whose top rows have already left the ring, or that finds
 //! the queue full, gets no patch; the driver counts it in `FrameEnd.dropped_sobel`.
 
+use heapless::Vec;
 use stereocal_wire::PATCH_SIZE;
 
 /// Points that can wait at once: the fabric's point FIFO depth, so a full FIFO drained in one
@@ -42,35 +43,25 @@ impl PendingPatch {
 
 /// A FIFO of pending patches, in point order.
 pub struct PatchQueue {
-    entries: [PendingPatch; MAX_PENDING],
-    len: usize,
+    entries: Vec<PendingPatch, MAX_PENDING>,
 }
 
 impl PatchQueue {
     /// An empty queue.
     pub const fn new() -> Self {
         Self {
-            entries: [PendingPatch {
-                index: 0,
-                octave: 0,
-                x: 0,
-                y: 0,
-            }; MAX_PENDING],
-            len: 0,
+            entries: Vec::new(),
         }
     }
 
     /// Empties the queue.
     pub fn clear(&mut self) {
-        self.len = 0;
+        self.entries.clear();
     }
 
     /// Queues `patch`; gives it back when the queue is full.
     pub fn push(&mut self, patch: PendingPatch) -> Result<(), PendingPatch> {
-        let slot = self.entries.get_mut(self.len).ok_or(patch)?;
-        *slot = patch;
-        self.len += 1;
-        Ok(())
+        self.entries.push(patch)
     }
 
     /// Removes and returns, in queue order, the first entry `ready` accepts.
@@ -78,11 +69,9 @@ impl PatchQueue {
         &mut self,
         mut ready: impl FnMut(&PendingPatch) -> bool,
     ) -> Option<PendingPatch> {
-        let i = self.entries[..self.len].iter().position(&mut ready)?;
-        let patch = self.entries[i];
-        self.entries.copy_within(i + 1..self.len, i);
-        self.len -= 1;
-        Some(patch)
+        let i = self.entries.iter().position(&mut ready)?;
+        // `i` came from `position`, so it is in bounds and `remove` cannot panic.
+        Some(self.entries.remove(i))
     }
 }
 

@@ -1,5 +1,6 @@
 //! Points from the fabric's point FIFO, collected into `PointBatch` packets.
 
+use heapless::Vec;
 use stereocal_wire::{Point, MAX_POINTS};
 
 use crate::fabric::Extremum;
@@ -20,43 +21,31 @@ pub fn wire_point(p: &Extremum) -> Point {
 
 /// Up to [`MAX_POINTS`] points waiting for their packet.
 pub struct PointBatch {
-    points: [Point; MAX_POINTS],
-    len: usize,
+    points: Vec<Point, MAX_POINTS>,
 }
 
 impl PointBatch {
     /// An empty batch.
     pub const fn new() -> Self {
-        Self {
-            points: [Point {
-                x: 0,
-                y: 0,
-                octave: 0,
-                scale: 0,
-                dx: 0,
-                dy: 0,
-                ds: 0,
-                dog: 0,
-            }; MAX_POINTS],
-            len: 0,
-        }
+        Self { points: Vec::new() }
     }
 
     /// Adds a point; `true` when the batch is now full and must be sent.
+    ///
+    /// The caller sends and clears the batch on the push that fills it, so there is always
+    /// room; a push onto a full batch would be refused (the point dropped) and answer `true`.
     pub fn push(&mut self, point: Point) -> bool {
-        self.points[self.len] = point;
-        self.len += 1;
-        self.len == MAX_POINTS
+        self.points.push(point).is_err() || self.points.is_full()
     }
 
     /// The points collected.
     pub fn points(&self) -> &[Point] {
-        &self.points[..self.len]
+        &self.points
     }
 
     /// Forgets the points (after they were sent).
     pub fn clear(&mut self) {
-        self.len = 0;
+        self.points.clear();
     }
 }
 
