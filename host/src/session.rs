@@ -18,6 +18,7 @@ use crate::estimator::{EstimatorConfig, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
 use crate::link::{Device, InProcessLink, LinkError};
 use crate::record::{FrameRecord, FrameStatus};
+use crate::summary::RunCost;
 
 /// Settings of a session.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,6 +96,16 @@ pub struct SessionCost {
     pub estimating: Duration,
     /// Link bytes of the delivered pairs.
     pub wire_bytes: u64,
+}
+
+/// What the summary reports of a session's cost.
+impl From<SessionCost> for RunCost {
+    fn from(cost: SessionCost) -> Self {
+        RunCost {
+            ms_per_frame_pair: cost.ms_per_pair(),
+            wire_bytes_per_pair: cost.wire_bytes_per_pair(),
+        }
+    }
 }
 
 impl SessionCost {

@@ -9,7 +9,7 @@ use clap::Args;
 use stereocal::hil::{
     instruction_reports, kernel_report, run_sequence, QemuConfig, QemuTimeouts, DEFAULT_QEMU,
 };
-use stereocal::summary::{Residual, RunCost, Summary};
+use stereocal::summary::{Residual, Summary};
 use stereocal::synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
 
 use super::options::EstimateArgs;
@@ -103,14 +103,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
 
     let (records, cost) = run.value;
     let (w, h) = sequence.image_size();
-    let summary = Summary::from_records(
-        &records,
-        Residual::Keep,
-        RunCost {
-            ms_per_frame_pair: cost.ms_per_pair(),
-            wire_bytes_per_pair: cost.wire_bytes_per_pair(),
-        },
-    );
+    let summary = Summary::from_records(&records, Residual::Keep, cost.into());
     let title = format!(
         "stereocal hil: {} ({}), seed {}, firmware under QEMU",
         args.scene,

@@ -9,7 +9,7 @@ use stereocal::calib::Calibration;
 use stereocal::record::FrameRecord;
 use stereocal::sequence::{GrayFrame, SizeLimits, StereoSequence};
 use stereocal::session::{fabric_config, Session};
-use stereocal::summary::{Residual, RunCost, Summary};
+use stereocal::summary::{Residual, Summary};
 use stereocal::verge_csv::read_truth_csv;
 use stereocal_hdl::regs::{MAX_HEIGHT, MAX_WIDTH, MIN_SIDE};
 
@@ -130,14 +130,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     })?;
     bar.finish_and_clear();
     let cost = session.cost();
-    let summary = Summary::from_records(
-        &records,
-        Residual::Remove,
-        RunCost {
-            ms_per_frame_pair: cost.ms_per_pair(),
-            wire_bytes_per_pair: cost.wire_bytes_per_pair(),
-        },
-    );
+    let summary = Summary::from_records(&records, Residual::Remove, cost.into());
     let title = format!("stereocal run: {}", args.left.display());
     finish(
         &records,

@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Args;
 use stereocal::eval::evaluate;
 use stereocal::session::SessionConfig;
-use stereocal::summary::{Residual, RunCost, Summary};
+use stereocal::summary::{Residual, Summary};
 use stereocal::synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
 
 use super::options::EstimateArgs;
@@ -135,14 +135,7 @@ fn run_sequence(
     let (records, cost) = evaluate(sequence, config, &mut |_| bar.inc(1))?;
     bar.finish_and_clear();
     let (w, h) = sequence.image_size();
-    let summary = Summary::from_records(
-        &records,
-        Residual::Keep,
-        RunCost {
-            ms_per_frame_pair: cost.ms_per_pair(),
-            wire_bytes_per_pair: cost.wire_bytes_per_pair(),
-        },
-    );
+    let summary = Summary::from_records(&records, Residual::Keep, cost.into());
     finish(&records, &summary, true, (w, h), finish_with)
 }
 

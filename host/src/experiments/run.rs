@@ -8,7 +8,7 @@ use crate::eval::evaluate;
 use crate::record::{FrameRecord, FrameStatus};
 use crate::report::write_outputs;
 use crate::session::{SessionConfig, SessionCost};
-use crate::summary::{percentile, Residual, RunCost, Summary};
+use crate::summary::{percentile, Residual, Summary};
 use crate::synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
 
 /// Which sequence, with which settings.
@@ -51,14 +51,7 @@ impl RunSpec {
             steps: sequence.len(),
         });
         let (records, cost) = evaluate(&sequence, self.config, &mut |_| progress(Progress::Step))?;
-        let summary = Summary::from_records(
-            &records,
-            Residual::Keep,
-            RunCost {
-                ms_per_frame_pair: cost.ms_per_pair(),
-                wire_bytes_per_pair: cost.wire_bytes_per_pair(),
-            },
-        );
+        let summary = Summary::from_records(&records, Residual::Keep, cost.into());
         Ok(Run {
             fps: sequence.config().fps,
             records,
