@@ -9,6 +9,12 @@ use crate::record::{FrameRecord, FrameStatus};
 /// the stability the span measures.
 pub const SETTLING_FRAMES: usize = 8;
 
+/// The first frame of a `frames`-frame run counted as settled: [`SETTLING_FRAMES`], or the
+/// first eighth of a shorter run.
+pub fn settled_from(frames: usize) -> usize {
+    (frames / 8).min(SETTLING_FRAMES)
+}
+
 /// Whether a constant offset between estimate and truth is part of the error.
 ///
 /// Synthetic sequences know the verge exactly, so every degree of offset is an error. A real
@@ -77,7 +83,7 @@ impl Summary {
             .iter()
             .filter_map(|r| Some((r.filtered_verge_deg? - r.truth_deg? - offset).abs()))
             .collect();
-        let settled_from = (records.len() / 8).min(SETTLING_FRAMES);
+        let settled_from = settled_from(records.len());
         let filtered: Vec<f64> = estimated
             .iter()
             .filter(|r| r.frame >= settled_from)

@@ -37,7 +37,7 @@ pub fn run(
     )?;
     let s = &run.summary;
     let raw = range(&run.raw());
-    let filtered = range(&run.filtered());
+    let filtered = range(&run.settled_filtered());
     let span = |r: Option<(f64, f64)>| r.map(|(lo, hi)| hi - lo);
     let speed = SequenceConfig::for_scene(SceneKind::Road).speed_mps;
     let mut table = Table::new(

@@ -66,7 +66,7 @@ pub fn run(
     );
     let column = |run: &Run| {
         let raw = run.raw_errors();
-        let span = range(&run.filtered()).map(|(lo, hi)| hi - lo);
+        let span = range(&run.settled_filtered()).map(|(lo, hi)| hi - lo);
         vec![
             fixed(Some(100.0 * run.summary.estimated_fraction()), 1),
             fixed(median(&raw), 4),

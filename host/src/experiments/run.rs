@@ -8,7 +8,7 @@ use crate::eval::evaluate;
 use crate::record::{FrameRecord, FrameStatus};
 use crate::report::write_outputs;
 use crate::session::{SessionConfig, SessionCost};
-use crate::summary::{percentile, Residual, Summary};
+use crate::summary::{percentile, settled_from, Residual, Summary};
 use crate::synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
 
 /// Which sequence, with which settings.
@@ -96,11 +96,13 @@ impl Run {
         )
     }
 
-    /// The filtered estimates of the estimated frames.
-    pub(crate) fn filtered(&self) -> Vec<f64> {
+    /// The filtered estimates of the estimated frames once the filter has settled, the same
+    /// frames the summary's `filtered_span_deg` covers (its range is that span).
+    pub(crate) fn settled_filtered(&self) -> Vec<f64> {
+        let settled_from = settled_from(self.records.len());
         self.records
             .iter()
-            .filter(|r| r.status == FrameStatus::Ok)
+            .filter(|r| r.status == FrameStatus::Ok && r.frame >= settled_from)
             .filter_map(|r| r.filtered_verge_deg)
             .collect()
     }
