@@ -16,6 +16,7 @@ pub mod output_dir;
 pub mod plot;
 pub mod ransac;
 pub mod record;
+pub mod reliability;
 pub mod report;
 pub mod sequence;
 pub mod session;

@@ -141,7 +141,9 @@ pub struct Session<D: Device = InProcessLink> {
     fabric: FabricConfig,
     estimator: VergeEstimator,
     filter: VergeFilter,
-    next_frame_id: Option<u32>,
+    /// The device's id of the next pair submitted: it numbers frames from 0 after it starts
+    /// (the firmware driver's channel), one per pair.
+    next_frame_id: u32,
     cost: SessionCost,
 }
 
@@ -179,7 +181,7 @@ impl<D: Device> Session<D> {
             fabric,
             estimator: VergeEstimator::new(calib, config.estimator),
             filter: VergeFilter::new(config.kalman),
-            next_frame_id: None,
+            next_frame_id: 0,
             cost: SessionCost::default(),
         })
     }
@@ -187,6 +189,11 @@ impl<D: Device> Session<D> {
     /// The fabric configuration in force.
     pub fn fabric(&self) -> &FabricConfig {
         &self.fabric
+    }
+
+    /// The device, e.g. to switch a fault injector or read an emulator's state.
+    pub fn device_mut(&mut self) -> &mut D {
+        self.driver.link_mut()
     }
 
     /// Cost so far.
@@ -225,15 +232,11 @@ impl<D: Device> Session<D> {
                 self.driver
                     .link_mut()
                     .submit_pair(left, right, timestamp_us)?;
-                let timeout = self.driver.link().answer_timeout();
-                let outcome = self.driver.next_pair(timeout)?;
-                self.check_step(frame, &outcome)?;
-                self.cost.wire_bytes += outcome.wire_bytes();
-                match outcome {
-                    PairOutcome::Pair {
+                match self.receive_pair(frame)? {
+                    Some(PairOutcome::Pair {
                         left: FrameOutcome::Delivered(left),
                         right: FrameOutcome::Delivered(right),
-                    } => {
+                    }) => {
                         record.status = FrameStatus::NoEstimate;
                         let estimating = Instant::now();
                         let estimate = self.estimator.estimate(&left.features, &right.features);
@@ -254,7 +257,7 @@ impl<D: Device> Session<D> {
                             Err(_) => None,
                         }
                     }
-                    _ => None,
+                    Some(_) | None => None,
                 }
             }
         };
@@ -296,19 +299,39 @@ impl<D: Device> Session<D> {
         }
     }
 
-    /// The device numbers frames itself; a pair that comes back with another id than the
-    /// one submitted means host and device disagree about which images they are.
-    fn check_step(&mut self, frame: usize, outcome: &PairOutcome) -> Result<(), SessionError> {
-        let got = outcome.frame_id();
-        let expected = self.next_frame_id.unwrap_or(got);
-        if got != expected {
-            return Err(SessionError::OutOfStep {
-                frame,
-                got,
-                expected,
-            });
+    /// The outcome of the pair just submitted; `None` when it never arrived complete.
+    ///
+    /// A link that loses bytes can lose a frame's end: the driver then times out on the pair,
+    /// and reports the frame as damaged only later, when the next frame's packets show the old
+    /// one will never finish. Such late reports carry an older frame id than the pair
+    /// submitted and are skipped (that frame was already recorded as dropped), so a fault
+    /// costs the frames it hit and never shifts a later estimate onto the wrong frame. A pair
+    /// with a newer id than any submitted means host and device disagree about which images
+    /// they are: that stops the session.
+    fn receive_pair(&mut self, frame: usize) -> Result<Option<PairOutcome>, SessionError> {
+        let expected = self.next_frame_id;
+        self.next_frame_id = expected.wrapping_add(1);
+        let timeout = self.driver.link().answer_timeout();
+        loop {
+            let outcome = match self.driver.next_pair(timeout) {
+                Ok(outcome) => outcome,
+                Err(DriverError::Timeout { .. }) => return Ok(None),
+                Err(e) => return Err(e.into()),
+            };
+            self.cost.wire_bytes += outcome.wire_bytes();
+            let got = outcome.frame_id();
+            // Ids wrap: "older" is within half the id space behind.
+            let behind = expected.wrapping_sub(got);
+            if got == expected {
+                return Ok(Some(outcome));
+            }
+            if behind > u32::MAX / 2 {
+                return Err(SessionError::OutOfStep {
+                    frame,
+                    got,
+                    expected,
+                });
+            }
         }
-        self.next_frame_id = Some(got.wrapping_add(1));
-        Ok(())
     }
 }

@@ -6,6 +6,7 @@ mod inject;
 mod options;
 mod output;
 mod real;
+mod reliability;
 mod synthetic;
 
 use clap::{Parser, Subcommand};
@@ -34,6 +35,8 @@ enum Command {
     Inject(inject::InjectArgs),
     /// Reproduce one of the thesis' experiments (or all) as CSV tables and PNG figures.
     Experiment(experiment::ExperimentArgs),
+    /// Sweep link faults over a rendered sequence and write docs/RELIABILITY.md.
+    Reliability(reliability::ReliabilityArgs),
 }
 
 impl Cli {
@@ -46,6 +49,7 @@ impl Cli {
             Command::Hil(a) => hil::hil(a),
             Command::Inject(a) => inject::inject(a),
             Command::Experiment(a) => experiment::experiment(a),
+            Command::Reliability(a) => reliability::reliability(a),
         }
     }
 }

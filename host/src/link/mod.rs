@@ -13,12 +13,14 @@
 //! | TCP (QEMU `-chardev socket,host=..,port=..`) | [`TcpLink`] | [`StreamLink::tcp`] |
 //! | Unix socket (QEMU `-chardev socket,path=..`) | [`UnixLink`] | [`StreamLink::unix`] |
 //! | a byte capture played back | [`ReplayLink`] | [`ReplayLink::new`], [`ReplayLink::from_file`] |
+//! | any link above, its received bytes damaged by seed | [`FaultLink`] | [`FaultLink::new`] |
 //! | the firmware ELF under `qemu-system-riscv32` | [`QemuDevice`](crate::hil::QemuDevice) | [`QemuDevice::start`](crate::hil::QemuDevice::start) |
 //!
 //! A link that also takes camera frames is a [`Device`]: what a session runs on.
 
 mod device;
 mod error;
+mod fault;
 mod in_process;
 mod replay;
 mod serial;
@@ -31,6 +33,7 @@ use std::time::Instant;
 
 pub use device::Device;
 pub use error::LinkError;
+pub use fault::{BadRate, FaultConfig, FaultCounts, FaultLink};
 pub use in_process::InProcessLink;
 pub use replay::ReplayLink;
 pub use serial::SerialLink;
