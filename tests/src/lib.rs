@@ -24,7 +24,7 @@ use std::time::Instant;
 use stereocal::calib::Calibration;
 use stereocal::eval::{fabric_size, sequence_calibration};
 use stereocal::hil::{run_on_qemu, HilError, QemuConfig, QemuRun, DEFAULT_QEMU};
-use stereocal::link::{Device, InProcessLink, Link, LinkError};
+use stereocal::link::{Device, InProcessLink, Recording};
 use stereocal::record::FrameRecord;
 use stereocal::session::{Session, SessionConfig, SessionError};
 use stereocal::synth::{SceneKind, Sequence, SequenceConfig};
@@ -134,52 +134,16 @@ pub struct Outcome {
     pub seconds: f64,
 }
 
-/// A device whose received bytes are kept.
-struct Recorded<D> {
-    device: D,
-    bytes: Vec<u8>,
-}
-
-impl<D: Link> Link for Recorded<D> {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        self.device.send(bytes)
-    }
-
-    fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
-        let n = self.device.recv(buf, deadline)?;
-        self.bytes.extend_from_slice(&buf[..n]);
-        Ok(n)
-    }
-}
-
-impl<D: Device> Device for Recorded<D> {
-    fn submit_pair(
-        &mut self,
-        left: &[u8],
-        right: &[u8],
-        timestamp_us: u64,
-    ) -> Result<(), LinkError> {
-        self.device.submit_pair(left, right, timestamp_us)
-    }
-
-    fn answer_timeout(&self) -> std::time::Duration {
-        self.device.answer_timeout()
-    }
-}
-
 /// The scenario on the in-process device (the fabric model's fast path, in this process).
 pub fn run_in_process(scenario: &Scenario) -> Outcome {
     let start = Instant::now();
-    let mut device = Recorded {
-        device: InProcessLink::new().expect("in-process device"),
-        bytes: Vec::new(),
-    };
+    let mut device = Recording::new(InProcessLink::new().expect("in-process device"));
     let records = scenario
         .run_session(&mut device)
         .unwrap_or_else(|e| panic!("{}: in-process run: {e}", scenario.name));
     Outcome {
         records,
-        bytes: device.bytes,
+        bytes: device.take_received(),
         seconds: start.elapsed().as_secs_f64(),
     }
 }

@@ -33,7 +33,7 @@ use stereocal_firmware::softcore::frame_input::VIRT_FRAME_REGION;
 
 use super::input::PairDigest;
 use super::{FirmwareExit, GrabberInput, HilError, TimeoutKind};
-use crate::link::{Device, Link, LinkError, StreamLink, UnixLink};
+use crate::link::{Device, Link, LinkError, Recording, StreamLink, UnixLink};
 
 /// The emulator, found on `PATH` unless [`QemuConfig::qemu`] says otherwise.
 pub const DEFAULT_QEMU: &str = "qemu-system-riscv32";
@@ -175,11 +175,10 @@ impl Drop for Process {
 pub struct QemuDevice {
     // Field order is drop order: the link closes, QEMU is killed, then the directory with
     // the socket and the frame file goes.
-    link: UnixLink,
+    link: Recording<UnixLink>,
     process: Process,
     loaded: Vec<PairDigest>,
     submitted: usize,
-    transcript: Vec<u8>,
     timeouts: QemuTimeouts,
     _dir: tempfile::TempDir,
 }
@@ -269,11 +268,13 @@ impl QemuDevice {
             }
         };
         Ok(Self {
-            link: StreamLink::from_stream(stream, format!("QEMU UART {}", socket.display())),
+            link: Recording::new(StreamLink::from_stream(
+                stream,
+                format!("QEMU UART {}", socket.display()),
+            )),
             process,
             loaded: input.digests.clone(),
             submitted: 0,
-            transcript: Vec::new(),
             timeouts: config.timeouts,
             _dir: dir,
         })
@@ -308,7 +309,7 @@ impl QemuDevice {
             .ok_or_else(|| timeout("QEMU to exit after its UART closed"))?;
         Ok(QemuEnd {
             exit,
-            transcript: std::mem::take(&mut self.transcript),
+            transcript: self.link.take_received(),
             stderr: self.process.stderr(),
         })
     }
@@ -325,7 +326,7 @@ impl QemuDevice {
         while self.recv(&mut buf, deadline).is_ok() {}
         QemuEnd {
             exit,
-            transcript: std::mem::take(&mut self.transcript),
+            transcript: self.link.take_received(),
             stderr: self.process.stderr(),
         }
     }
@@ -342,9 +343,7 @@ impl Link for QemuDevice {
     }
 
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
-        let n = self.link.recv(buf, deadline)?;
-        self.transcript.extend_from_slice(&buf[..n]);
-        Ok(n)
+        self.link.recv(buf, deadline)
     }
 }
 
@@ -360,7 +359,7 @@ impl Device for QemuDevice {
         let digest = PairDigest::of(left, right, timestamp_us);
         if self.loaded.get(self.submitted) != Some(&digest) {
             return Err(LinkError::Io {
-                link: self.link.name().into(),
+                link: self.link.inner().name().into(),
                 source: io::Error::new(
                     io::ErrorKind::InvalidInput,
                     format!(
