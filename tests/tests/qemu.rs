@@ -175,9 +175,11 @@ fn qemu_instructions_per_pixel_640x240_are_deterministic() {
     for (a, b) in first.iter().zip(&second) {
         assert_eq!(a.front_end, b.front_end, "front-end counts of two runs");
         // The driver's count carries a few instructions around each UART wait, and how
-        // often the transmitter is busy depends on how fast the host reads.
+        // often the transmitter is busy depends on how fast the host reads: on an idle
+        // machine two runs differ by tens of instructions in 53 million, under a loaded CI
+        // run by thousands (1.1e-4 seen). 1e-3 still pins the per-pixel figure to ±0.35.
         let spread = a.driver.abs_diff(b.driver) as f64 / a.driver as f64;
-        assert!(spread < 1e-4, "driver counts {} and {}", a.driver, b.driver);
+        assert!(spread < 1e-3, "driver counts {} and {}", a.driver, b.driver);
     }
     for r in &first {
         assert_eq!(r.pixels, 640 * 240);
