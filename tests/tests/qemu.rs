@@ -19,6 +19,7 @@ use stereocal::session::{fabric_config, SessionConfig, SessionError};
 use stereocal::summary::{Residual, RunCost, Summary};
 use stereocal::synth::{SceneKind, Sequence, SequenceConfig};
 use stereocal_firmware::softcore::finisher::ExitCode;
+use stereocal_firmware::softcore::stack::StackReport;
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hil::{
     assert_same_records, assert_same_stream, qemu_or_skip, real_data_or_skip, run_in_process,
@@ -251,4 +252,68 @@ fn qemu_answer_timeout_is_named() {
     );
     assert!(err.to_string().contains("the answer timeout"), "{err}");
     eprintln!("{test}: {err}");
+}
+
+/// The main loop's worst-case stack at 640x480, both Sobel output modes: the firmware paints
+/// the free stack at boot and reports the deepest overwritten word after the last frame
+/// (`stereocal_firmware::softcore::stack`); the mark is found and below the region. Printed
+/// for the README.
+#[test]
+fn qemu_stack_high_water_640x480_rows_and_patches() {
+    let test = "qemu_stack_high_water_640x480_rows_and_patches";
+    let Some(qemu) = qemu_or_skip(test) else {
+        return;
+    };
+    // The stack report rides on the instruction-count flag, the run that logs measurements.
+    let qemu = QemuConfig {
+        count_instructions: true,
+        ..qemu
+    };
+    let mut deepest = 0;
+    for (mode, sobel_output) in [
+        ("rows", SobelOutput::Rows),
+        ("patches", SobelOutput::Patches),
+    ] {
+        let config = SessionConfig {
+            sobel_output,
+            ..SessionConfig::default()
+        };
+        let scenario = Scenario::synthetic(SceneKind::Road, 640, 480, 1, config);
+        let (outcome, run) =
+            run_qemu(&scenario, &qemu).unwrap_or_else(|e| panic!("{test}: {mode}: {e}"));
+        assert!(
+            run.end.exit.is_success(),
+            "{test}: {mode}: {}",
+            run.end.exit
+        );
+        assert_eq!(outcome.records.len(), 1, "{test}: {mode}: one pair");
+        let reports: Vec<StackReport> = run
+            .logs
+            .iter()
+            .filter(|log| log.level.is_none())
+            .filter_map(|log| StackReport::parse(&log.text))
+            .collect();
+        let [report] = reports[..] else {
+            panic!("{test}: {mode}: expected one stack report, got {reports:?}");
+        };
+        assert!(
+            report.boot > 0 && report.main_loop > 0,
+            "{test}: {mode}: no overwritten word: {report:?}"
+        );
+        assert!(
+            report.worst() < report.region,
+            "{test}: {mode}: the stack reached the bottom of its region: {report:?}"
+        );
+        eprintln!(
+            "{test}: Sobel {mode}, 640x480 pair: stack high-water mark, main loop {} bytes \
+             ({:.1} KiB), boot {} bytes ({:.1} KiB), of a {} byte region",
+            report.main_loop,
+            f64::from(report.main_loop) / 1024.0,
+            report.boot,
+            f64::from(report.boot) / 1024.0,
+            report.region
+        );
+        deepest = deepest.max(report.worst());
+    }
+    eprintln!("{test}: worst case over both modes: {deepest} bytes");
 }

@@ -13,7 +13,8 @@
 //!    answered; clearing `CONTROL.ENABLE` pauses before the next frame. With
 //!    `FLAG_COUNT_INSTRUCTIONS` each image's instruction counts follow as a log packet, and
 //!    after the last frame the row kernels' counts on the first image
-//!    (`softcore::instructions`).
+//!    (`softcore::instructions`), preceded by the main loop's stack high-water mark
+//!    (`softcore::stack`: the free stack is painted first thing at boot).
 //! 4. Exit through the `sifive_test` finisher: 0 when every frame ran, 2 for a bad input
 //!    region, 3 when a frame failed (an `ErrorReport` says why), 101 on a panic.
 //!
@@ -43,6 +44,7 @@ mod soft_core {
     };
     use stereocal_firmware::softcore::instructions::{self, CountedFrontEnd, InstructionReport};
     use stereocal_firmware::softcore::link::{Uart0, LINK};
+    use stereocal_firmware::softcore::stack::{self, StackReport};
     use stereocal_hdl::regs::{control, height, width};
     use stereocal_hdl::{RegisterBank, RegisterBus};
     use stereocal_wire::{
@@ -149,6 +151,7 @@ mod soft_core {
 
     #[riscv_rt::entry]
     fn main() -> ! {
+        stack::paint();
         Uart0::device().init();
         // SAFETY: the region is RAM above the program (memory.x) that nothing writes while the
         // firmware runs; QEMU's loader filled it before the hart started.
@@ -168,6 +171,10 @@ mod soft_core {
             channel(&header, Camera::Left),
             channel(&header, Camera::Right),
         ];
+        // Boot is the deepest the stack goes (the channels are built by value); paint again
+        // so that the mark after the frames is the main loop's own.
+        let (boot_stack, _) = stack::high_water();
+        stack::paint();
         let channels = &mut channels[..usize::from(header.cameras)];
         if header.has_flag(FLAG_AUTOSTART) {
             send(&hello());
@@ -211,6 +218,13 @@ mod soft_core {
             }
         }
         if header.has_flag(FLAG_COUNT_INSTRUCTIONS) {
+            // Before the row-kernel measurement, whose buffers are not the main loop's.
+            let (main_loop, region) = stack::high_water();
+            stack::log(&StackReport {
+                boot: boot_stack,
+                main_loop,
+                region,
+            });
             let kernels = input
                 .image(0, 0)
                 .and_then(|image| instructions::measure_kernels(image.pixels, header.width.into()));

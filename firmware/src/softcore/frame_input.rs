@@ -20,7 +20,8 @@
 //! with the register reset values instead of waiting for the host to set `CONTROL.ENABLE`;
 //! bit 1 ([`FLAG_REGISTER_MODEL`]) runs the register-level fabric model instead of the fast
 //! path; bit 2 ([`FLAG_COUNT_INSTRUCTIONS`]) reports every image's instruction counts in a
-//! `Log` packet. Other bits must be 0.
+//! `Log` packet (and after the last frame the stack high-water marks, `super::stack`).
+//! Other bits must be 0.
 
 /// Start of the input region on the QEMU `virt` machine (16 MiB into DRAM, above the
 /// program; see `firmware/memory.x`).

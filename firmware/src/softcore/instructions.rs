@@ -45,7 +45,11 @@ pub struct InstructionReport {
 
 /// The numbers of a report line `PREFIX name value name value ...`, in `names` order;
 /// `None` unless the line is exactly that.
-fn fields<const N: usize>(text: &str, prefix: &str, names: [&str; N]) -> Option<[u64; N]> {
+pub(crate) fn fields<const N: usize>(
+    text: &str,
+    prefix: &str,
+    names: [&str; N],
+) -> Option<[u64; N]> {
     let mut words = text.split_whitespace();
     if words.next()? != prefix {
         return None;

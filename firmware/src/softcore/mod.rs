@@ -2,9 +2,10 @@
 //! input region, and on the bare-metal target the link writer, the defmt logger and the panic
 //! handler.
 //!
-//! `uart`, `finisher`, `frame_input` and `instructions` build everywhere (the host writes
-//! frame-input files with [`frame_input::InputHeader::emit`] and reads instruction reports
-//! with [`instructions::InstructionReport::parse`]); the rest only exists on
+//! `uart`, `finisher`, `frame_input`, `instructions` and `stack` build everywhere (the host
+//! writes frame-input files with [`frame_input::InputHeader::emit`] and reads instruction
+//! and stack reports with [`instructions::InstructionReport::parse`] and
+//! [`stack::StackReport::parse`]); the rest only exists on
 //! `target_os = "none"`, where it is linked into the ELF.
 //!
 //! # Running the ELF under QEMU
@@ -30,12 +31,14 @@
 //! host to wait for `FrameEnd`).
 //!
 //! Instructions per frame: set [`frame_input::FLAG_COUNT_INSTRUCTIONS`] and run with
-//! `-icount shift=0`; each image then logs its `minstret` deltas ([`instructions`]).
+//! `-icount shift=0`; each image then logs its `minstret` deltas ([`instructions`]), and
+//! after the last frame the main loop's stack high-water mark ([`stack`]).
 //! `stereocal hil --count-instructions` does both.
 
 pub mod finisher;
 pub mod frame_input;
 pub mod instructions;
+pub mod stack;
 pub mod uart;
 
 #[cfg(target_os = "none")]
