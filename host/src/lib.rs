@@ -20,6 +20,7 @@ pub mod reliability;
 pub mod report;
 pub mod sequence;
 pub mod session;
+pub mod soak;
 pub mod subpixel;
 pub mod summary;
 pub mod synth;

@@ -173,3 +173,56 @@ fn a_session_over_a_damaging_link_drops_frames_and_keeps_estimates_exact() {
         }
     }
 }
+
+/// The soak, short: faults on every frame of a session, every estimate equal to the clean
+/// run's for the same rendered pair, the estimated frames within the accuracy bar, and the
+/// resident set sampled where it was asked for.
+#[test]
+fn a_short_soak_keeps_estimates_exact_and_samples_memory() {
+    use stereocal::soak::{soak, SoakConfig, MEDIAN_BAR_DEG};
+
+    let config = SoakConfig {
+        frames: 60,
+        cycle: 6,
+        seed: 1,
+        width: 640,
+        height: 480,
+        kind: FaultKind::All,
+        rate: 3e-8,
+        sample_every: 20,
+    };
+    let s = soak(config, &|_| {}).unwrap();
+    assert_eq!(s.frames, 60);
+    assert_eq!(s.delivered + s.dropped, 60, "{s:?}");
+    assert!(s.dropped > 0, "no frame was damaged: {s:?}");
+    assert!(s.estimated > 0, "no frame was estimated: {s:?}");
+    assert_eq!(s.wrong, 0, "{s:?}");
+    let median = s.median_deg.unwrap();
+    assert!(median <= MEDIAN_BAR_DEG, "median raw error {median}°");
+    assert!(s.accurate());
+    // Memory plumbing (flatness is judged on the long soak: this test shares its process
+    // with the others).
+    if std::path::Path::new("/proc/self/status").exists() {
+        let frames: Vec<usize> = s.memory.iter().map(|m| m.frame).collect();
+        assert_eq!(frames, [20, 40, 60]);
+        assert!(s.memory.iter().all(|m| m.rss_kib > 0), "{:?}", s.memory);
+        assert_eq!(s.baseline().unwrap().frame, 40);
+        assert!(s.growth_kib().is_some());
+    }
+    let md = stereocal::soak::markdown(&s, "stereocal reliability --soak 60");
+    assert!(md.contains("| **wrong estimates** | **0** |"), "{md}");
+}
+
+#[test]
+fn the_soak_section_is_replaced_in_place_or_appended() {
+    use stereocal::soak::{section, splice, SECTION_BEGIN, SECTION_END};
+
+    let one = format!("{SECTION_BEGIN}\n## Soak\none\n{SECTION_END}\n");
+    let two = format!("{SECTION_BEGIN}\n## Soak\ntwo\n{SECTION_END}\n");
+    let doc = splice("# Sweep\n\ntable\n", &one);
+    assert_eq!(doc, format!("# Sweep\n\ntable\n\n{one}"));
+    assert_eq!(section(&doc), Some(one.as_str()));
+    let doc = splice(&doc, &two);
+    assert_eq!(doc, format!("# Sweep\n\ntable\n\n{two}"));
+    assert_eq!(section("# Sweep\n"), None);
+}
