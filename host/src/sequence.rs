@@ -227,22 +227,39 @@ fn list_images(camera: &'static str, dir: &Path) -> Result<Vec<PathBuf>, Sequenc
 
 /// Decodes one image file to 8-bit grey (colour by the `image` crate's luma conversion).
 pub fn load_gray(path: &Path) -> Result<GrayFrame, SequenceError> {
-    let img = image::ImageReader::open(path)
-        .map_err(|e| SequenceError::Decode {
-            path: path.to_owned(),
-            source: image::ImageError::IoError(e),
-        })?
+    let bytes = std::fs::read(path).map_err(|e| SequenceError::Decode {
+        path: path.to_owned(),
+        source: image::ImageError::IoError(e),
+    })?;
+    decode_gray(&bytes, path)
+}
+
+/// Decodes an image held in memory exactly as [`load_gray`] decodes the file at
+/// `path_for_errors`: the format comes from the content when it is recognisable, else from the
+/// path's extension, and every error names `path_for_errors`. The fuzz target `image` drives it.
+pub fn decode_gray(bytes: &[u8], path_for_errors: &Path) -> Result<GrayFrame, SequenceError> {
+    let err = |source| SequenceError::Decode {
+        path: path_for_errors.to_owned(),
+        source,
+    };
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    // As `ImageReader::open` does: the extension names the format unless the content does.
+    let ext = path_for_errors.extension().filter(|ext| !ext.is_empty());
+    if let Some(format) = ext.and_then(image::ImageFormat::from_extension) {
+        reader.set_format(format);
+    }
+    let reader = reader
         .with_guessed_format()
-        .map_err(|e| SequenceError::Decode {
-            path: path.to_owned(),
-            source: image::ImageError::IoError(e),
-        })?
-        .decode()
-        .map_err(|source| SequenceError::Decode {
-            path: path.to_owned(),
-            source,
-        })?
-        .into_luma8();
+        .map_err(|e| err(image::ImageError::IoError(e)))?;
+    if reader.format().is_none() {
+        if let Some(ext) = ext {
+            // The error `ImageReader::open(..).decode()` gives for an unknown extension.
+            return Err(err(image::ImageError::Unsupported(
+                image::error::ImageFormatHint::PathExtension(ext.into()).into(),
+            )));
+        }
+    }
+    let img = reader.decode().map_err(err)?.into_luma8();
     Ok(GrayFrame {
         width: img.width() as usize,
         height: img.height() as usize,
