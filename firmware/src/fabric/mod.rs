@@ -19,7 +19,8 @@
 //!
 //! Stages: [`linebuffer`], [`convolver`] (row then column, LUT distributed arithmetic), [`dog`],
 //! [`window`], [`extrema`], [`edge`], [`refine`], [`sobel`], [`cordic`], [`subsample`],
-//! assembled in [`octave`] and [`pipeline`]; [`latency`] and [`memory`] give the figures.
+//! assembled in [`octave`] and [`pipeline`] ([`probe`]: the RTL's observation ports);
+//! [`latency`] and [`memory`] give the figures.
 
 pub mod config;
 pub mod convolver;
@@ -36,6 +37,7 @@ pub mod memory;
 pub mod octave;
 pub mod output;
 pub mod pipeline;
+pub mod probe;
 pub mod refine;
 pub mod sobel;
 pub mod subsample;
@@ -46,3 +48,4 @@ pub use config::{Config, ConfigError};
 pub use fast::FastFrontEnd;
 pub use output::{run_frame, Extremum, FrameError, FrontEnd, Overflow, SobelPixel};
 pub use pipeline::RegisterFrontEnd;
+pub use probe::{ClockProbe, OctaveProbe};

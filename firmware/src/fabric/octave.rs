@@ -27,6 +27,7 @@ use crate::fabric::extrema::{is_extremum, Cube};
 use crate::fabric::fifo::LineFifo;
 use crate::fabric::geometry::octave_dims;
 use crate::fabric::output::{Extremum, OutputFifos, SobelPixel};
+use crate::fabric::probe::OctaveProbe;
 use crate::fabric::refine::refine;
 use crate::fabric::sobel::sobel;
 use crate::fabric::subsample::Subsampler;
@@ -157,10 +158,14 @@ impl<const W: usize> Octave<W> {
 
     /// One clock. `input` is a Q8.8 sample (valid strobe = `Some`). Returns the subsampler's
     /// output register: the next octave's input during this clock.
+    ///
+    /// On a clock the octave is enabled it records its observation signals in `probe`
+    /// ([`crate::fabric::probe`]); otherwise `probe` is left as it is (the caller resets it).
     pub fn clock<const W0: usize>(
         &mut self,
         input: Option<u16>,
         out: &mut OutputFifos<W0>,
+        probe: &mut OctaveProbe,
     ) -> Option<u16> {
         let flushing = self.taken == self.total && !self.done();
         if input.is_none() && !flushing {
@@ -169,6 +174,7 @@ impl<const W: usize> Octave<W> {
         if input.is_some() {
             self.taken += 1;
         }
+        probe.en = true;
 
         // Gaussian cascade: every stage samples its upstream stage's output register.
         let mut g = [None; 4];
@@ -183,16 +189,21 @@ impl<const W: usize> Octave<W> {
             };
             wire = *gi;
         }
+        probe.g = g;
 
         // Sobel branch.
-        if let Some((x, y, magnitude, orientation)) = self.cordic.clock(self.gradient_reg.take()) {
-            out.push_sobel(SobelPixel {
-                octave: self.index,
-                orientation,
-                magnitude,
-                x,
-                y,
-            });
+        probe.sobel =
+            self.cordic
+                .clock(self.gradient_reg.take())
+                .map(|(x, y, magnitude, orientation)| SobelPixel {
+                    octave: self.index,
+                    orientation,
+                    magnitude,
+                    x,
+                    y,
+                });
+        if let Some(px) = probe.sobel {
+            out.push_sobel(px);
         }
         let s = self.config.sobel_scale as usize & 3;
         if let Some(win) = self.sobel_window.clock(g[s]) {
@@ -201,7 +212,8 @@ impl<const W: usize> Octave<W> {
         }
 
         // Detector branch, last register first.
-        if let Some(p) = self.refine_reg.take() {
+        probe.point = self.refine_reg.take();
+        if let Some(p) = probe.point {
             out.push_point(p);
         }
         let cfg = self.config;
@@ -223,7 +235,8 @@ impl<const W: usize> Octave<W> {
             .take()
             .filter(|(_, _, c)| passes_edge_test(&c[1], cfg.edge_ratio));
         let (w, h) = (self.width, self.height);
-        self.detect_reg = self.dog_window.clock(self.dog_reg.take()).and_then(|win| {
+        probe.dog = self.dog_reg.take();
+        self.detect_reg = self.dog_window.clock(probe.dog).and_then(|win| {
             let interior = win.x >= 1 && win.y >= 1 && win.x + 2 <= w && win.y + 2 <= h;
             if !interior {
                 return None;
@@ -260,6 +273,7 @@ impl<const W: usize> Octave<W> {
             }
         }
 
-        self.subsampler.clock(g[3])
+        probe.sub = self.subsampler.clock(g[3]);
+        probe.sub
     }
 }

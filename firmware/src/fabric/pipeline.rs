@@ -8,6 +8,7 @@
 use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::octave::Octave;
 use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
+use crate::fabric::probe::ClockProbe;
 
 /// Register-level front end (see the module docs for the width parameters).
 #[derive(Clone, Debug)]
@@ -26,6 +27,7 @@ pub struct RegisterFrontEnd<
     rows_in: u16,
     clock: u64,
     first_input: [Option<u64>; MAX_OCTAVES],
+    probe: ClockProbe,
 }
 
 impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> Default
@@ -56,6 +58,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
             rows_in: 0,
             clock: 0,
             first_input: [None; MAX_OCTAVES],
+            probe: ClockProbe::IDLE,
         }
     }
 
@@ -81,8 +84,27 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
             + self.o3.align_errors()
     }
 
+    /// The observation signals of the last [`Self::clock`] (the `sc_frontend` observation
+    /// ports during that clock, [`crate::fabric::probe`]); idle before the first clock of a
+    /// frame.
+    pub fn probe(&self) -> &ClockProbe {
+        &self.probe
+    }
+
+    /// Whether every configured octave has emitted everything: [`FrontEnd::frame_done`]
+    /// without its input-row count (the RTL's `done` output).
+    pub fn octaves_done(&self) -> bool {
+        let Some(cfg) = self.config else { return false };
+        let n = cfg.octaves;
+        self.o0.done()
+            && (n < 2 || self.o1.done())
+            && (n < 3 || self.o2.done())
+            && (n < 4 || self.o3.done())
+    }
+
     /// One pixel clock; `pixel = None` is a clock without a valid pixel (blanking).
     pub fn clock(&mut self, pixel: Option<u8>) {
+        self.probe = ClockProbe::IDLE;
         let Some(cfg) = self.config else { return };
         let n = cfg.octaves as usize;
         let now = self.clock;
@@ -93,16 +115,17 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
         };
         let x0 = pixel.map(|p| (p as u16) << 8);
         note(0, x0);
-        let x1 = self.o0.clock(x0, &mut self.fifos);
+        let [p0, p1, p2, p3] = &mut self.probe.octaves;
+        let x1 = self.o0.clock(x0, &mut self.fifos, p0);
         if n > 1 {
             note(1, x1);
-            let x2 = self.o1.clock(x1, &mut self.fifos);
+            let x2 = self.o1.clock(x1, &mut self.fifos, p1);
             if n > 2 {
                 note(2, x2);
-                let x3 = self.o2.clock(x2, &mut self.fifos);
+                let x3 = self.o2.clock(x2, &mut self.fifos, p2);
                 if n > 3 {
                     note(3, x3);
-                    self.o3.clock(x3, &mut self.fifos);
+                    self.o3.clock(x3, &mut self.fifos, p3);
                 }
             }
         }
@@ -124,6 +147,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.rows_in = 0;
         self.clock = 0;
         self.first_input = [None; MAX_OCTAVES];
+        self.probe = ClockProbe::IDLE;
         Ok(())
     }
 
@@ -156,12 +180,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
 
     fn frame_done(&self) -> bool {
         let Some(cfg) = self.config else { return false };
-        let n = cfg.octaves;
-        self.rows_in == cfg.height
-            && self.o0.done()
-            && (n < 2 || self.o1.done())
-            && (n < 3 || self.o2.done())
-            && (n < 4 || self.o3.done())
+        self.rows_in == cfg.height && self.octaves_done()
     }
 
     fn pop_point(&mut self) -> Option<Extremum> {
