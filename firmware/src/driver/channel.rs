@@ -5,7 +5,7 @@ use stereocal_hdl::{register_at, FabricConfig, RegisterBus};
 use stereocal_wire::{
     Camera, Capabilities, ErrorCode, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr,
     HelloRepr, PacketRepr, PointBatchRepr, Records, RegisterValueRepr, SobelPatchRepr, SobelPixel,
-    SobelRowsRepr, PATCH_PIXELS, PATCH_SIZE, PROTOCOL_VERSION,
+    SobelRowsRepr, PATCH_PIXELS, PROTOCOL_VERSION,
 };
 
 use crate::driver::error::{DriverError, ERROR_UNEXPECTED_KIND};
@@ -322,10 +322,11 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
             x: point.x,
             y: point.y,
         };
-        if point.octave >= self.ring.octaves() {
+        let Some(rows) = self.ring.rows(point.octave) else {
             return Err(outside);
-        }
-        let (width, height) = self.ring.dims(point.octave);
+        };
+        let (width, height) = rows.dims();
+        let done = rows.next_row();
         if point.x >= width || point.y >= height {
             return Err(outside);
         }
@@ -348,7 +349,7 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
             x: point.x,
             y: point.y,
         };
-        if self.ring.next_row(point.octave) >= pending.rows_needed_before(height) {
+        if done >= pending.rows_needed_before(height) {
             self.send_patch(&pending, out)
         } else if self.patches.push(pending).is_err() {
             self.frame.patches_dropped = self.frame.patches_dropped.saturating_add(1);
@@ -399,8 +400,10 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
                 }
             }
             SobelOutput::Patches => {
-                let done = self.ring.next_row(octave);
-                let (_, height) = self.ring.dims(octave);
+                let Some(rows) = self.ring.rows(octave) else {
+                    return Ok(());
+                };
+                let (done, (_, height)) = (rows.next_row(), rows.dims());
                 while let Some(patch) = self
                     .patches
                     .take_first(|p| p.octave == octave && done >= p.rows_needed_before(height))
@@ -418,10 +421,10 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         patch: &PendingPatch,
         out: &mut PacketWriter<S>,
     ) -> Result<(), DriverError> {
-        let (_, height) = self.ring.dims(patch.octave);
-        let top_held = patch.first_row() >= self.ring.oldest_row(patch.octave);
-        let top_in_image = patch.first_row() < height;
-        if !(top_held && top_in_image) {
+        let top_held = self.ring.rows(patch.octave).is_some_and(|rows| {
+            patch.first_row() >= rows.oldest_row() && patch.first_row() < rows.dims().1
+        });
+        if !top_held {
             self.frame.patches_dropped = self.frame.patches_dropped.saturating_add(1);
             return Ok(());
         }
@@ -429,7 +432,6 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
             patch.octave,
             i32::from(patch.x) - i32::from(HALF),
             i32::from(patch.y) - i32::from(HALF),
-            PATCH_SIZE,
             &mut self.patch,
         );
         send(

@@ -12,7 +12,7 @@
 
 use core::ops::Range;
 
-use stereocal_wire::SobelPixel;
+use stereocal_wire::{SobelPixel, PATCH_PIXELS, PATCH_SIZE};
 
 use crate::fabric::config::MAX_OCTAVES;
 use crate::fabric::geometry::octave_dims;
@@ -25,9 +25,9 @@ pub const RING_ROWS: usize = 32;
 /// `RING_ROWS * (2 * W0 + 2) <= (2 * RING_ROWS + 4) * W0` once `W0 >= RING_ROWS / 2`.
 const STORE_ROWS: usize = 2 * RING_ROWS + 4;
 
-/// Where each octave's rows live and how far its stream got.
-#[derive(Clone, Copy, Debug, Default)]
-struct OctaveRows {
+/// Where one octave's rows live and how far its stream got.
+#[derive(Clone, Copy, Debug)]
+pub struct OctaveRows {
     width: u16,
     height: u16,
     /// Flat index of the octave's first slot.
@@ -36,6 +36,47 @@ struct OctaveRows {
     next_row: u16,
     /// Whether `next_row` already has pixels.
     open: bool,
+    /// Pixels received into each slot since it was opened.
+    filled: [u16; RING_ROWS],
+}
+
+impl OctaveRows {
+    const EMPTY: Self = Self {
+        width: 0,
+        height: 0,
+        base: 0,
+        next_row: 0,
+        open: false,
+        filled: [0; RING_ROWS],
+    };
+
+    /// Width and height of the octave's image.
+    pub fn dims(&self) -> (u16, u16) {
+        (self.width, self.height)
+    }
+
+    /// Rows before this one are complete.
+    pub fn next_row(&self) -> u16 {
+        self.next_row
+    }
+
+    /// The oldest complete row still held.
+    pub fn oldest_row(&self) -> u16 {
+        (self.next_row + u16::from(self.open)).saturating_sub(RING_ROWS as u16)
+    }
+
+    /// Flat store indices of `row`'s slot.
+    fn slot(&self, row: u16) -> Range<usize> {
+        let width = usize::from(self.width);
+        let start = self.base + (usize::from(row) % RING_ROWS) * width;
+        start..start + width
+    }
+
+    /// Pixels received into `row`'s slot (`RING_ROWS` is a power of two: the index is
+    /// in range by construction).
+    fn filled(&mut self, row: u16) -> &mut u16 {
+        &mut self.filled[usize::from(row) % RING_ROWS]
+    }
 }
 
 /// A Sobel pixel the ring cannot place.
@@ -59,10 +100,11 @@ pub struct Completed {
 }
 
 /// The ring of Sobel rows of a front end whose octave 0 is at most `W0` pixels wide.
+///
+/// Nothing here can panic on what the fabric sends: octave numbers, positions and slots are
+/// looked up with `get`, and a pixel that finds no place is an [`OutOfOrder`] error.
 pub struct SobelRing<const W0: usize> {
     store: [[SobelPixel; W0]; STORE_ROWS],
-    /// Pixels received into each slot since it was opened.
-    filled: [[u16; RING_ROWS]; MAX_OCTAVES],
     octaves: [OctaveRows; MAX_OCTAVES],
     active: u8,
 }
@@ -74,27 +116,22 @@ impl<const W0: usize> SobelRing<W0> {
             assert!(
                 W0 >= RING_ROWS / 2,
                 "the ring packs every octave into STORE_ROWS rows of W0"
-            )
+            );
+            assert!(RING_ROWS.is_power_of_two());
         };
         Self {
             store: [[SobelPixel {
                 magnitude: 0,
                 orientation: 0,
             }; W0]; STORE_ROWS],
-            filled: [[0; RING_ROWS]; MAX_OCTAVES],
-            octaves: [OctaveRows {
-                width: 0,
-                height: 0,
-                base: 0,
-                next_row: 0,
-                open: false,
-            }; MAX_OCTAVES],
+            octaves: [OctaveRows::EMPTY; MAX_OCTAVES],
             active: 0,
         }
     }
 
     /// Prepares for a `width` x `height` frame of `octaves` octaves (`width <= W0`,
-    /// `octaves <= 4`, both checked by the caller).
+    /// `octaves <= 4`, both checked by the caller; a wider frame would find no slots and its
+    /// pixels would be refused, not stored out of place).
     pub fn start(&mut self, width: u16, height: u16, octaves: u8) {
         let mut base = 0;
         self.active = octaves;
@@ -104,31 +141,17 @@ impl<const W0: usize> SobelRing<W0> {
                 width: w,
                 height: h,
                 base,
-                next_row: 0,
-                open: false,
+                ..OctaveRows::EMPTY
             };
             base += RING_ROWS * usize::from(w);
         }
-        debug_assert!(base <= STORE_ROWS * W0, "width {width} > W0 {W0}");
-        self.filled = [[0; RING_ROWS]; MAX_OCTAVES];
     }
 
-    /// Octaves of the current frame.
-    pub fn octaves(&self) -> u8 {
-        self.active
-    }
-
-    /// Width and height of octave `k`'s image.
-    pub fn dims(&self, octave: u8) -> (u16, u16) {
-        let rows = &self.octaves[usize::from(octave)];
-        (rows.width, rows.height)
-    }
-
-    fn slot_range(&self, octave: u8, row: u16) -> Range<usize> {
-        let rows = &self.octaves[usize::from(octave)];
-        let width = usize::from(rows.width);
-        let start = rows.base + (usize::from(row) % RING_ROWS) * width;
-        start..start + width
+    /// Octave `k` of the current frame, if it has one.
+    pub fn rows(&self, octave: u8) -> Option<&OctaveRows> {
+        self.octaves
+            .get(usize::from(octave))
+            .filter(|_| octave < self.active)
     }
 
     /// Stores one pixel of the fabric's Sobel stream and reports the rows it completed.
@@ -138,39 +161,39 @@ impl<const W0: usize> SobelRing<W0> {
             x: pixel.x,
             y: pixel.y,
         };
-        if pixel.octave >= self.active {
-            return Err(out_of_order);
-        }
-        let k = usize::from(pixel.octave);
-        let OctaveRows {
-            width,
-            height,
-            next_row,
-            open,
-            ..
-        } = self.octaves[k];
-        if pixel.x >= width || pixel.y >= height || pixel.y < next_row {
+        let active = self.active;
+        let rows = self
+            .octaves
+            .get_mut(usize::from(pixel.octave))
+            .filter(|_| pixel.octave < active)
+            .ok_or(out_of_order)?;
+        if pixel.x >= rows.width || pixel.y >= rows.height || pixel.y < rows.next_row {
             return Err(out_of_order);
         }
         // Rows before the pixel's own are complete, whether or not they got pixels.
-        let first = next_row;
-        if pixel.y > next_row || !open {
-            self.open_row(pixel.octave, pixel.y);
+        let first = rows.next_row;
+        if pixel.y > rows.next_row || !rows.open {
+            open_row(self.store.as_flattened_mut(), rows, pixel.y);
         }
-        let slot = self.slot_range(pixel.octave, pixel.y);
-        self.store.as_flattened_mut()[slot.start + usize::from(pixel.x)] = SobelPixel {
+        let cell = rows.slot(pixel.y).start + usize::from(pixel.x);
+        let cell = self
+            .store
+            .as_flattened_mut()
+            .get_mut(cell)
+            .ok_or(out_of_order)?;
+        *cell = SobelPixel {
             magnitude: pixel.magnitude,
             orientation: pixel.orientation,
         };
-        let filled = &mut self.filled[k][usize::from(pixel.y) % RING_ROWS];
+        let filled = rows.filled(pixel.y);
         *filled = filled.saturating_add(1);
-        let end = if pixel.x + 1 == width {
-            self.octaves[k].next_row = pixel.y + 1;
-            self.octaves[k].open = false;
+        let end = if pixel.x + 1 == rows.width {
+            rows.next_row = pixel.y + 1;
+            rows.open = false;
             pixel.y + 1
         } else {
-            self.octaves[k].next_row = pixel.y;
-            self.octaves[k].open = true;
+            rows.next_row = pixel.y;
+            rows.open = true;
             pixel.y
         };
         Ok((end > first).then_some(Completed {
@@ -179,28 +202,12 @@ impl<const W0: usize> SobelRing<W0> {
         }))
     }
 
-    /// Clears the slot of `row` and the slots of the empty rows skipped before it.
-    fn open_row(&mut self, octave: u8, row: u16) {
-        let k = usize::from(octave);
-        let from = if self.octaves[k].open {
-            self.octaves[k].next_row + 1
-        } else {
-            self.octaves[k].next_row
-        };
-        // Only the last RING_ROWS rows can still be read; older slots are reused anyway.
-        let from = from.max(row.saturating_sub(RING_ROWS as u16 - 1));
-        for r in from..=row {
-            let slot = self.slot_range(octave, r);
-            self.store.as_flattened_mut()[slot].fill(SobelPixel::default());
-            self.filled[k][usize::from(r) % RING_ROWS] = 0;
-        }
-    }
-
     /// Completes each octave's open row at the end of a frame.
     pub fn finish(&mut self) -> [Option<Completed>; MAX_OCTAVES] {
         let mut done = [const { None }; MAX_OCTAVES];
+        let active = usize::from(self.active);
         for (k, (rows, done)) in self.octaves.iter_mut().zip(done.iter_mut()).enumerate() {
-            if k < usize::from(self.active) && rows.open {
+            if k < active && rows.open {
                 *done = Some(Completed {
                     octave: k as u8,
                     rows: rows.next_row..rows.next_row + 1,
@@ -212,44 +219,51 @@ impl<const W0: usize> SobelRing<W0> {
         done
     }
 
-    /// Rows of `octave` before this one are complete.
-    pub fn next_row(&self, octave: u8) -> u16 {
-        self.octaves[usize::from(octave)].next_row
-    }
-
-    /// The oldest complete row of `octave` still held.
-    pub fn oldest_row(&self, octave: u8) -> u16 {
-        let rows = &self.octaves[usize::from(octave)];
-        (rows.next_row + u16::from(rows.open)).saturating_sub(RING_ROWS as u16)
-    }
-
     /// A complete row that is still held and received at least one pixel.
     pub fn row(&self, octave: u8, row: u16) -> Option<&[SobelPixel]> {
-        let k = usize::from(octave);
-        let held = row >= self.oldest_row(octave) && row < self.octaves[k].next_row;
-        let filled = self.filled[k][usize::from(row) % RING_ROWS] > 0;
-        (held && filled).then(|| &self.store.as_flattened()[self.slot_range(octave, row)])
+        let rows = self.rows(octave)?;
+        let held = row >= rows.oldest_row() && row < rows.next_row;
+        let filled = rows.filled[usize::from(row) % RING_ROWS] > 0;
+        if !(held && filled) {
+            return None;
+        }
+        self.store.as_flattened().get(rows.slot(row))
     }
 
-    /// Copies the `size` x `size` window whose top-left corner is (`left`, `top`) (in octave
-    /// pixels, possibly outside the image) into `out`, row-major; pixels outside the image or
-    /// in rows not held read as zero.
-    pub fn window(&self, octave: u8, left: i32, top: i32, size: usize, out: &mut [SobelPixel]) {
-        let (width, _) = self.dims(octave);
-        for (dy, out_row) in out.chunks_exact_mut(size).enumerate() {
+    /// Copies the patch whose top-left corner is (`left`, `top`) (in octave pixels, possibly
+    /// outside the image) into `out`, row-major; pixels outside the image or in rows not held
+    /// read as zero.
+    pub fn window(&self, octave: u8, left: i32, top: i32, out: &mut [SobelPixel; PATCH_PIXELS]) {
+        for (dy, out_row) in out.chunks_exact_mut(PATCH_SIZE).enumerate() {
             out_row.fill(SobelPixel::default());
-            let y = top + dy as i32;
+            let y = top.saturating_add(dy as i32);
             let Some(row) = u16::try_from(y).ok().and_then(|y| self.row(octave, y)) else {
                 continue;
             };
-            let x0 = left.max(0);
-            let x1 = (left + size as i32).min(i32::from(width));
-            if x0 < x1 {
-                let (x0, x1) = (x0 as usize, x1 as usize);
-                let dest = (x0 as i32 - left) as usize;
-                out_row[dest..dest + (x1 - x0)].copy_from_slice(&row[x0..x1]);
+            for (dx, pixel) in out_row.iter_mut().enumerate() {
+                let x = left.saturating_add(dx as i32);
+                if let Some(p) = usize::try_from(x).ok().and_then(|x| row.get(x)) {
+                    *pixel = *p;
+                }
             }
         }
+    }
+}
+
+/// Clears the slot of `row` and the slots of the empty rows skipped before it.
+fn open_row(store: &mut [SobelPixel], rows: &mut OctaveRows, row: u16) {
+    let from = if rows.open {
+        rows.next_row + 1
+    } else {
+        rows.next_row
+    };
+    // Only the last RING_ROWS rows can still be read; older slots are reused anyway.
+    let from = from.max(row.saturating_sub(RING_ROWS as u16 - 1));
+    for r in from..=row {
+        if let Some(slot) = store.get_mut(rows.slot(r)) {
+            slot.fill(SobelPixel::default());
+        }
+        *rows.filled(r) = 0;
     }
 }
 
