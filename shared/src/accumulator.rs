@@ -80,9 +80,11 @@ impl<const N: usize> Accumulator<N> {
         }
         let mut input = input;
         loop {
-            let (chunk, delimited, rest) = match input.iter().position(|&byte| byte == DELIMITER) {
-                Some(at) => (&input[..at], true, &input[at + 1..]),
-                None => (input, false, &input[input.len()..]),
+            let mut parts = input.splitn(2, |&byte| byte == DELIMITER);
+            let chunk = parts.next().unwrap_or_default();
+            let (delimited, rest) = match parts.next() {
+                Some(rest) => (true, rest),
+                None => (false, &[][..]),
             };
             if self.discarding {
                 if !delimited {

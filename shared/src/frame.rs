@@ -36,7 +36,10 @@ pub fn encode<'o>(seq: u16, repr: &PacketRepr<'_>, out: &'o mut [u8]) -> Result<
     }
     let packet_len = HEADER_LEN + payload_len + CRC_LEN;
     let offset = cobs::max_encoding_overhead(packet_len);
-    let mut packet = header::Packet::new_unchecked(&mut out[offset..offset + packet_len]);
+    let mut packet = header::Packet::new_unchecked(
+        out.get_mut(offset..offset + packet_len)
+            .ok_or(Error::EncodeBufferTooSmall)?,
+    );
     let header = Header {
         version: PROTOCOL_VERSION,
         kind: repr.kind(),
@@ -47,18 +50,21 @@ pub fn encode<'o>(seq: u16, repr: &PacketRepr<'_>, out: &'o mut [u8]) -> Result<
     header.emit(&mut packet)?;
     repr.emit(packet.payload_mut())?;
     packet.fill_crc();
-    let frame_len = cobs_encode_in_place(out, offset, packet_len);
-    out[frame_len] = DELIMITER;
-    Ok(&out[..=frame_len])
+    // `out` holds `max_frame_len` bytes (checked above), so neither `None` below happens.
+    let frame_len =
+        cobs_encode_in_place(out, offset, packet_len).ok_or(Error::EncodeBufferTooSmall)?;
+    *out.get_mut(frame_len).ok_or(Error::EncodeBufferTooSmall)? = DELIMITER;
+    out.get(..=frame_len).ok_or(Error::EncodeBufferTooSmall)
 }
 
-/// COBS-encodes `buf[src..src + len]` into `buf[..]` and returns the encoded length.
+/// COBS-encodes `buf[src..src + len]` into `buf[..]` and returns the encoded length, or
+/// `None` (before finishing) should `buf` be too short, which [`encode`] rules out.
 ///
 /// The `cobs` crate's encoder state machine does the transform; this loop only moves bytes.
 /// It is safe in place when `src >= cobs::max_encoding_overhead(len)`: before input byte `i`
 /// is written, the output holds at most `i` bytes plus one code byte per started block, at
 /// most `1 + i / 254 <= src` extra bytes, so no unread input byte is overwritten.
-fn cobs_encode_in_place(buf: &mut [u8], src: usize, len: usize) -> usize {
+fn cobs_encode_in_place(buf: &mut [u8], src: usize, len: usize) -> Option<usize> {
     let mut state = EncoderState::default();
     // buf[0] is the first code byte, written once its block closes.
     let mut dest = 1;
@@ -66,23 +72,23 @@ fn cobs_encode_in_place(buf: &mut [u8], src: usize, len: usize) -> usize {
     // follow (COBS drops a final empty block after a full one).
     let mut block_just_filled = false;
     for i in src..src + len {
-        let byte = buf[i];
+        let byte = *buf.get(i)?;
         if block_just_filled {
             dest += 1;
             block_just_filled = false;
         }
         match state.push(byte) {
             PushResult::AddSingle(value) => {
-                buf[dest] = value;
+                *buf.get_mut(dest)? = value;
                 dest += 1;
             }
             PushResult::ModifyFromStartAndSkip((code_at, code)) => {
-                buf[code_at] = code;
+                *buf.get_mut(code_at)? = code;
                 dest += 1;
             }
             PushResult::ModifyFromStartAndPushAndSkip((code_at, code, value)) => {
-                buf[code_at] = code;
-                buf[dest] = value;
+                *buf.get_mut(code_at)? = code;
+                *buf.get_mut(dest)? = value;
                 dest += 1;
                 block_just_filled = true;
             }
@@ -90,9 +96,9 @@ fn cobs_encode_in_place(buf: &mut [u8], src: usize, len: usize) -> usize {
     }
     if !block_just_filled {
         let (code_at, code) = state.finalize();
-        buf[code_at] = code;
+        *buf.get_mut(code_at)? = code;
     }
-    dest
+    Some(dest)
 }
 
 /// Decodes one frame in place and parses it.
@@ -105,15 +111,46 @@ pub fn decode(frame: &mut [u8]) -> Result<(Header, PacketRepr<'_>), Error> {
         Some(&DELIMITER) => frame.len() - 1,
         _ => frame.len(),
     };
-    let encoded = &mut frame[..encoded_len];
+    let encoded = frame
+        .get_mut(..encoded_len)
+        .ok_or(Error::DecodeUnexpectedEnd)?;
     if encoded.is_empty() {
         return Err(Error::DecodeUnexpectedEnd);
     }
     if encoded.contains(&DELIMITER) {
         return Err(Error::DecodeBadCobs);
     }
-    let packet_len = cobs::decode_in_place(encoded).map_err(|_| Error::DecodeBadCobs)?;
-    parse_packet(&frame[..packet_len])
+    let packet_len = cobs_decode_in_place(encoded).ok_or(Error::DecodeBadCobs)?;
+    let encoded: &[u8] = encoded;
+    parse_packet(encoded.get(..packet_len).ok_or(Error::DecodeBadCobs)?)
+}
+
+/// COBS-decodes `buf` (no `0x00` in it) in place and returns the decoded length, or `None`
+/// when a code byte points past the end. The same transform and the same rejections as
+/// `cobs::decode_in_place`, written with checked accesses so the firmware links no panic.
+fn cobs_decode_in_place(buf: &mut [u8]) -> Option<usize> {
+    let end = buf.len();
+    let mut src = 0;
+    let mut dest = 0;
+    while let Some(&code) = buf.get(src) {
+        let code = usize::from(code);
+        if src + code > end && code != 1 {
+            return None;
+        }
+        src += 1;
+        for _ in 1..code {
+            // `dest < src` throughout, so the write never overtakes the read.
+            let byte = *buf.get(src)?;
+            *buf.get_mut(dest)? = byte;
+            src += 1;
+            dest += 1;
+        }
+        if code != 0xff && src < end {
+            *buf.get_mut(dest)? = 0;
+            dest += 1;
+        }
+    }
+    Some(dest)
 }
 
 /// Checks and parses the bytes of a whole packet (after COBS decoding).
@@ -129,7 +166,29 @@ fn parse_packet(bytes: &[u8]) -> Result<(Header, PacketRepr<'_>), Error> {
         return Err(Error::DecodeUnknownVersion);
     }
     let header = Header::parse(&packet)?;
-    let payload = &bytes[HEADER_LEN..bytes.len() - CRC_LEN];
+    let payload = bytes
+        .get(HEADER_LEN..bytes.len() - CRC_LEN)
+        .ok_or(Error::DecodeUnexpectedEnd)?;
     let repr = PacketRepr::parse(header.kind, payload)?;
     Ok((header, repr))
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The checked in-place decoder agrees with the `cobs` crate on any zero-free input.
+        #[test]
+        fn cobs_decode_matches_the_cobs_crate(bytes in proptest::collection::vec(1u8..=255, 1..600)) {
+            let mut ours = bytes.clone();
+            let mut theirs = bytes;
+            let expected = cobs::decode_in_place(&mut theirs).ok();
+            let got = super::cobs_decode_in_place(&mut ours);
+            prop_assert_eq!(got, expected);
+            if let Some(len) = got {
+                prop_assert_eq!(&ours[..len], &theirs[..len]);
+            }
+        }
+    }
 }

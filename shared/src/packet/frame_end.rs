@@ -50,7 +50,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Camera.
     pub fn camera(&self) -> Camera {
-        Camera::from(self.buffer.as_ref()[field::CAMERA])
+        Camera::from(le::read_u8(self.buffer.as_ref(), field::CAMERA))
     }
 
     /// Points sent for this frame.
@@ -65,7 +65,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Overflow flag bits.
     pub fn flags(&self) -> u8 {
-        self.buffer.as_ref()[field::FLAGS]
+        le::read_u8(self.buffer.as_ref(), field::FLAGS)
     }
 
     /// Points lost to a full point FIFO.
@@ -87,7 +87,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the camera.
     pub fn set_camera(&mut self, value: Camera) {
-        self.buffer.as_mut()[field::CAMERA] = u8::from(value);
+        le::write_u8(self.buffer.as_mut(), field::CAMERA, u8::from(value));
     }
 
     /// Sets the point count.
@@ -102,7 +102,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the flag bits.
     pub fn set_flags(&mut self, value: u8) {
-        self.buffer.as_mut()[field::FLAGS] = value;
+        le::write_u8(self.buffer.as_mut(), field::FLAGS, value);
     }
 
     /// Sets the dropped point count.

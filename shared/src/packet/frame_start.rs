@@ -45,7 +45,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Camera.
     pub fn camera(&self) -> Camera {
-        Camera::from(self.buffer.as_ref()[field::CAMERA])
+        Camera::from(le::read_u8(self.buffer.as_ref(), field::CAMERA))
     }
 
     /// Octave-0 width in pixels.
@@ -60,7 +60,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Number of octaves the fabric computes for this frame.
     pub fn octaves(&self) -> u8 {
-        self.buffer.as_ref()[field::OCTAVES]
+        le::read_u8(self.buffer.as_ref(), field::OCTAVES)
     }
 
     /// Capture time of the first pixel, device clock, microseconds.
@@ -77,7 +77,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the camera.
     pub fn set_camera(&mut self, value: Camera) {
-        self.buffer.as_mut()[field::CAMERA] = u8::from(value);
+        le::write_u8(self.buffer.as_mut(), field::CAMERA, u8::from(value));
     }
 
     /// Sets the width.
@@ -92,7 +92,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the octave count.
     pub fn set_octaves(&mut self, value: u8) {
-        self.buffer.as_mut()[field::OCTAVES] = value;
+        le::write_u8(self.buffer.as_mut(), field::OCTAVES, value);
     }
 
     /// Sets the timestamp.

@@ -45,12 +45,12 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Protocol version of the sender.
     pub fn version(&self) -> u8 {
-        self.buffer.as_ref()[field::VERSION]
+        le::read_u8(self.buffer.as_ref(), field::VERSION)
     }
 
     /// Packet kind.
     pub fn kind(&self) -> PacketKind {
-        PacketKind::from(self.buffer.as_ref()[field::KIND])
+        PacketKind::from(le::read_u8(self.buffer.as_ref(), field::KIND))
     }
 
     /// Sequence number; the sender increments it (wrapping) per packet, so gaps show loss.
@@ -66,31 +66,31 @@ impl<T: AsRef<[u8]>> Packet<T> {
     /// The payload bytes.
     pub fn payload(&self) -> &[u8] {
         let data = self.buffer.as_ref();
-        &data[field::PAYLOAD..data.len() - CRC_LEN]
+        le::sub(data, field::PAYLOAD..data.len().saturating_sub(CRC_LEN))
     }
 
     /// The CRC stored in the trailer.
     pub fn crc(&self) -> u32 {
         let data = self.buffer.as_ref();
-        le::read_u32(data, data.len() - CRC_LEN..data.len())
+        le::read_u32(data, data.len().saturating_sub(CRC_LEN)..data.len())
     }
 
     /// `true` when the trailer matches the CRC-32C of everything before it.
     pub fn verify_crc(&self) -> bool {
         let data = self.buffer.as_ref();
-        crc32c(&data[..data.len() - CRC_LEN]) == self.crc()
+        crc32c(le::sub(data, ..data.len().saturating_sub(CRC_LEN))) == self.crc()
     }
 }
 
 impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
     /// Sets the protocol version.
     pub fn set_version(&mut self, value: u8) {
-        self.buffer.as_mut()[field::VERSION] = value;
+        le::write_u8(self.buffer.as_mut(), field::VERSION, value);
     }
 
     /// Sets the packet kind.
     pub fn set_kind(&mut self, value: PacketKind) {
-        self.buffer.as_mut()[field::KIND] = u8::from(value);
+        le::write_u8(self.buffer.as_mut(), field::KIND, u8::from(value));
     }
 
     /// Sets the sequence number.
@@ -106,15 +106,15 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
     /// The payload bytes, for a payload view to emit into.
     pub fn payload_mut(&mut self) -> &mut [u8] {
         let data = self.buffer.as_mut();
-        let end = data.len() - CRC_LEN;
-        &mut data[field::PAYLOAD..end]
+        let end = data.len().saturating_sub(CRC_LEN);
+        le::sub_mut(data, field::PAYLOAD..end)
     }
 
     /// Computes the CRC over header and payload and stores it in the trailer.
     pub fn fill_crc(&mut self) {
         let data = self.buffer.as_mut();
-        let end = data.len() - CRC_LEN;
-        let crc = crc32c(&data[..end]);
+        let end = data.len().saturating_sub(CRC_LEN);
+        let crc = crc32c(le::sub(data, ..end));
         le::write_u32(data, end..data.len(), crc);
     }
 }

@@ -37,7 +37,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Highest protocol version the sender speaks.
     pub fn version(&self) -> u8 {
-        self.buffer.as_ref()[field::VERSION]
+        le::read_u8(self.buffer.as_ref(), field::VERSION)
     }
 
     /// Capability bits.
@@ -49,7 +49,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
     /// Sets the highest protocol version the sender speaks.
     pub fn set_version(&mut self, value: u8) {
-        self.buffer.as_mut()[field::VERSION] = value;
+        le::write_u8(self.buffer.as_mut(), field::VERSION, value);
     }
 
     /// Sets the capability bits.

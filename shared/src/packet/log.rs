@@ -64,7 +64,9 @@ impl<'a> LogRepr<'a> {
             return Err(Error::EncodeTooManyRecords);
         }
         check_room(packet.buffer.as_ref().len(), self.buffer_len())?;
-        packet.buffer.as_mut()[..self.frame.len()].copy_from_slice(self.frame);
+        for (out, byte) in packet.buffer.as_mut().iter_mut().zip(self.frame) {
+            *out = *byte;
+        }
         Ok(())
     }
 }

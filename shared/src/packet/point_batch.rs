@@ -86,8 +86,8 @@ impl Record for Point {
         Point {
             x: le::read_u16(bytes, point::X),
             y: le::read_u16(bytes, point::Y),
-            octave: bytes[point::OCTAVE],
-            scale: bytes[point::SCALE],
+            octave: le::read_u8(bytes, point::OCTAVE),
+            scale: le::read_u8(bytes, point::SCALE),
             dx: le::read_i16(bytes, point::DX),
             dy: le::read_i16(bytes, point::DY),
             ds: le::read_i16(bytes, point::DS),
@@ -99,8 +99,8 @@ impl Record for Point {
         use field::point;
         le::write_u16(bytes, point::X, self.x);
         le::write_u16(bytes, point::Y, self.y);
-        bytes[point::OCTAVE] = self.octave;
-        bytes[point::SCALE] = self.scale;
+        le::write_u8(bytes, point::OCTAVE, self.octave);
+        le::write_u8(bytes, point::SCALE, self.scale);
         le::write_i16(bytes, point::DX, self.dx);
         le::write_i16(bytes, point::DY, self.dy);
         le::write_i16(bytes, point::DS, self.ds);
@@ -134,7 +134,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Camera.
     pub fn camera(&self) -> Camera {
-        Camera::from(self.buffer.as_ref()[field::CAMERA])
+        Camera::from(le::read_u8(self.buffer.as_ref(), field::CAMERA))
     }
 
     /// Number of point records.
@@ -144,7 +144,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// The point records, as bytes.
     pub fn points(&self) -> &[u8] {
-        &self.buffer.as_ref()[field::POINTS..]
+        le::sub(self.buffer.as_ref(), field::POINTS..)
     }
 }
 
@@ -156,7 +156,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the camera.
     pub fn set_camera(&mut self, value: Camera) {
-        self.buffer.as_mut()[field::CAMERA] = u8::from(value);
+        le::write_u8(self.buffer.as_mut(), field::CAMERA, u8::from(value));
     }
 
     /// Sets the record count.
@@ -166,7 +166,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// The point records, as bytes to write.
     pub fn points_mut(&mut self) -> &mut [u8] {
-        &mut self.buffer.as_mut()[field::POINTS..]
+        le::sub_mut(self.buffer.as_mut(), field::POINTS..)
     }
 }
 
@@ -192,7 +192,7 @@ impl<'a> PointBatchRepr<'a> {
         Ok(PointBatchRepr {
             frame_id: packet.frame_id(),
             camera: packet.camera(),
-            points: Records::Wire(&data[field::POINTS..]),
+            points: Records::Wire(le::sub(data, field::POINTS..)),
         })
     }
 

@@ -57,7 +57,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Camera.
     pub fn camera(&self) -> Camera {
-        Camera::from(self.buffer.as_ref()[field::CAMERA])
+        Camera::from(le::read_u8(self.buffer.as_ref(), field::CAMERA))
     }
 
     /// The keypoint's index among the frame's points.
@@ -67,12 +67,12 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Octave.
     pub fn octave(&self) -> u8 {
-        self.buffer.as_ref()[field::OCTAVE]
+        le::read_u8(self.buffer.as_ref(), field::OCTAVE)
     }
 
     /// Scale index within the octave.
     pub fn scale(&self) -> u8 {
-        self.buffer.as_ref()[field::SCALE]
+        le::read_u8(self.buffer.as_ref(), field::SCALE)
     }
 
     /// Patch centre column, octave pixels.
@@ -87,7 +87,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// The pixels, as bytes.
     pub fn pixels(&self) -> &[u8] {
-        &self.buffer.as_ref()[field::PIXELS..]
+        le::sub(self.buffer.as_ref(), field::PIXELS..)
     }
 }
 
@@ -99,7 +99,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the camera.
     pub fn set_camera(&mut self, value: Camera) {
-        self.buffer.as_mut()[field::CAMERA] = u8::from(value);
+        le::write_u8(self.buffer.as_mut(), field::CAMERA, u8::from(value));
     }
 
     /// Sets the keypoint index.
@@ -109,12 +109,12 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the octave.
     pub fn set_octave(&mut self, value: u8) {
-        self.buffer.as_mut()[field::OCTAVE] = value;
+        le::write_u8(self.buffer.as_mut(), field::OCTAVE, value);
     }
 
     /// Sets the scale.
     pub fn set_scale(&mut self, value: u8) {
-        self.buffer.as_mut()[field::SCALE] = value;
+        le::write_u8(self.buffer.as_mut(), field::SCALE, value);
     }
 
     /// Sets the centre column.
@@ -129,7 +129,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// The pixels, as bytes to write.
     pub fn pixels_mut(&mut self) -> &mut [u8] {
-        &mut self.buffer.as_mut()[field::PIXELS..]
+        le::sub_mut(self.buffer.as_mut(), field::PIXELS..)
     }
 }
 
@@ -162,7 +162,7 @@ impl<'a> SobelPatchRepr<'a> {
     ) -> Result<SobelPatchRepr<'a>, Error> {
         packet.check_len()?;
         let data: &'a [u8] = packet.buffer.as_ref();
-        let pixels = &data[field::PIXELS..];
+        let pixels = le::sub(data, field::PIXELS..);
         if !all_valid(pixels) {
             return Err(Error::DecodeBadOrientation);
         }

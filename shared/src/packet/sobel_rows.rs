@@ -62,17 +62,17 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// Camera.
     pub fn camera(&self) -> Camera {
-        Camera::from(self.buffer.as_ref()[field::CAMERA])
+        Camera::from(le::read_u8(self.buffer.as_ref(), field::CAMERA))
     }
 
     /// Octave.
     pub fn octave(&self) -> u8 {
-        self.buffer.as_ref()[field::OCTAVE]
+        le::read_u8(self.buffer.as_ref(), field::OCTAVE)
     }
 
     /// Scale index within the octave.
     pub fn scale(&self) -> u8 {
-        self.buffer.as_ref()[field::SCALE]
+        le::read_u8(self.buffer.as_ref(), field::SCALE)
     }
 
     /// Row number in the octave's image.
@@ -87,7 +87,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 
     /// The pixels, as bytes.
     pub fn pixels(&self) -> &[u8] {
-        &self.buffer.as_ref()[field::PIXELS..]
+        le::sub(self.buffer.as_ref(), field::PIXELS..)
     }
 }
 
@@ -99,17 +99,17 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// Sets the camera.
     pub fn set_camera(&mut self, value: Camera) {
-        self.buffer.as_mut()[field::CAMERA] = u8::from(value);
+        le::write_u8(self.buffer.as_mut(), field::CAMERA, u8::from(value));
     }
 
     /// Sets the octave.
     pub fn set_octave(&mut self, value: u8) {
-        self.buffer.as_mut()[field::OCTAVE] = value;
+        le::write_u8(self.buffer.as_mut(), field::OCTAVE, value);
     }
 
     /// Sets the scale.
     pub fn set_scale(&mut self, value: u8) {
-        self.buffer.as_mut()[field::SCALE] = value;
+        le::write_u8(self.buffer.as_mut(), field::SCALE, value);
     }
 
     /// Sets the row number.
@@ -124,7 +124,7 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
 
     /// The pixels, as bytes to write.
     pub fn pixels_mut(&mut self) -> &mut [u8] {
-        &mut self.buffer.as_mut()[field::PIXELS..]
+        le::sub_mut(self.buffer.as_mut(), field::PIXELS..)
     }
 }
 
@@ -153,7 +153,7 @@ impl<'a> SobelRowsRepr<'a> {
     ) -> Result<SobelRowsRepr<'a>, Error> {
         packet.check_len()?;
         let data: &'a [u8] = packet.buffer.as_ref();
-        let pixels = &data[field::PIXELS..];
+        let pixels = le::sub(data, field::PIXELS..);
         if !all_valid(pixels) {
             return Err(Error::DecodeBadOrientation);
         }
