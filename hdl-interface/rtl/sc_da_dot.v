@@ -27,8 +27,8 @@ module sc_da_dot #(
         end
     endfunction
 
-    wire [10:0] rom [0:31];
-    wire [10:0] pp  [0:15];
+    wire [10:0]     rom [0:31];
+    wire [16*11-1:0] pp;  // partial product of bit plane b at [b*11 +: 11]
 
     genvar m, b;
     generate
@@ -36,7 +36,7 @@ module sc_da_dot #(
             assign rom[m] = lut(m);
         end
         for (b = 0; b < 16; b = b + 1) begin : g_plane
-            assign pp[b] = rom[{s[4*16 + b], s[3*16 + b], s[2*16 + b], s[1*16 + b], s[b]}];
+            assign pp[b*11 +: 11] = rom[{s[4*16 + b], s[3*16 + b], s[2*16 + b], s[1*16 + b], s[b]}];
         end
     endgenerate
 
@@ -45,7 +45,7 @@ module sc_da_dot #(
     always @* begin
         acc = 26'd512;
         for (k = 0; k < 16; k = k + 1)
-            acc = acc + ({15'd0, pp[k]} << k);
+            acc = acc + ({15'd0, pp[k*11 +: 11]} << k);
     end
 
     assign y = acc[25:10];
