@@ -7,18 +7,18 @@
 #define STEREOCAL_BASE_ADDR 0x40000000u
 #define STEREOCAL_WINDOW_SIZE 0x100u
 #define STEREOCAL_REGISTER_WIDTH 32u
-#define STEREOCAL_VERSION_MAJOR 1u
+#define STEREOCAL_VERSION_MAJOR 2u
 #define STEREOCAL_VERSION_MINOR 0u
 #define STEREOCAL_MAX_HEIGHT 1024u
 #define STEREOCAL_MAX_OCTAVES 4u
 #define STEREOCAL_MAX_WIDTH 1280u
 #define STEREOCAL_MIN_SIDE 16u
 #define STEREOCAL_POINT_FIFO_DEPTH 512u
-#define STEREOCAL_SOBEL_FIFO_DEPTH 4096u
+#define STEREOCAL_SOBEL_FIFO_DEPTH 3840u
 
 /* VERSION (ro): Identifies the fabric and the register-map version it implements. */
 #define STEREOCAL_VERSION_OFFSET 0x00u
-#define STEREOCAL_VERSION_RESET 0x5C010100u
+#define STEREOCAL_VERSION_RESET 0x5C010200u
 /* [7:0] ro: Register-map minor version (additive changes only). */
 #define STEREOCAL_VERSION_MINOR_SHIFT 0u
 #define STEREOCAL_VERSION_MINOR_WIDTH 8u
@@ -28,7 +28,7 @@
 #define STEREOCAL_VERSION_MAJOR_SHIFT 8u
 #define STEREOCAL_VERSION_MAJOR_WIDTH 8u
 #define STEREOCAL_VERSION_MAJOR_MASK 0x0000FF00u
-#define STEREOCAL_VERSION_MAJOR_RESET 0x1u
+#define STEREOCAL_VERSION_MAJOR_RESET 0x2u
 /* [31:16] ro: Constant 0x5C01: a read of anything else means no stereocal fabric at this address. */
 #define STEREOCAL_VERSION_MAGIC_SHIFT 16u
 #define STEREOCAL_VERSION_MAGIC_WIDTH 16u
@@ -38,7 +38,7 @@
 /* CONTROL (rw): Run control. Configuration registers are sampled at each start of frame. */
 #define STEREOCAL_CONTROL_OFFSET 0x04u
 #define STEREOCAL_CONTROL_RESET 0x00000000u
-/* [0:0] rw: 1: the pipeline runs. 0: PIXEL_IN ready is held low and no stage advances. */
+/* [0:0] rw: 1: the pipeline takes pixels. 0: PIXEL_IN ready is held low (a frame already taken keeps flushing its last rows through the octaves). */
 #define STEREOCAL_CONTROL_ENABLE_SHIFT 0u
 #define STEREOCAL_CONTROL_ENABLE_WIDTH 1u
 #define STEREOCAL_CONTROL_ENABLE_MASK 0x00000001u
@@ -111,14 +111,14 @@
 #define STEREOCAL_OCTAVES_COUNT_MIN 1u
 #define STEREOCAL_OCTAVES_COUNT_MAX 4u
 
-/* CONTRAST_THRESHOLD (rw): Low-contrast rejection of extrema. */
+/* CONTRAST_THRESHOLD (rw): Low-contrast rejection of extrema (Config::contrast_threshold of the model). */
 #define STEREOCAL_CONTRAST_THRESHOLD_OFFSET 0x18u
-#define STEREOCAL_CONTRAST_THRESHOLD_RESET 0x00000008u
-/* [7:0] rw: An extremum is kept only if |DoG| >= VALUE. DoG units are grey levels of the 8-bit smoothed images (a DoG sample is the difference of two of them, -255..255); 8 is about Lowe's 0.03 of full scale. */
+#define STEREOCAL_CONTRAST_THRESHOLD_RESET 0x00000800u
+/* [15:0] rw: Q8.8 grey levels (256 = 1.0 grey level): an extremum is kept only if its DoG sample is a strict maximum above VALUE or a strict minimum below -VALUE. DoG samples are differences of two Q8.8 smoothed images. The reset 0x0800 (8.0 grey levels, about Lowe's 0.03 of full scale) is v1's reset of 8 whole grey levels; the model's Config::new and the host's session use 0x0100 (1.0). */
 #define STEREOCAL_CONTRAST_THRESHOLD_VALUE_SHIFT 0u
-#define STEREOCAL_CONTRAST_THRESHOLD_VALUE_WIDTH 8u
-#define STEREOCAL_CONTRAST_THRESHOLD_VALUE_MASK 0x000000FFu
-#define STEREOCAL_CONTRAST_THRESHOLD_VALUE_RESET 0x8u
+#define STEREOCAL_CONTRAST_THRESHOLD_VALUE_WIDTH 16u
+#define STEREOCAL_CONTRAST_THRESHOLD_VALUE_MASK 0x0000FFFFu
+#define STEREOCAL_CONTRAST_THRESHOLD_VALUE_RESET 0x800u
 
 /* EDGE_THRESHOLD (rw): Edge-response rejection of extrema (Lowe's principal-curvature ratio). */
 #define STEREOCAL_EDGE_THRESHOLD_OFFSET 0x1Cu
@@ -131,17 +131,17 @@
 #define STEREOCAL_EDGE_THRESHOLD_R_MIN 1u
 #define STEREOCAL_EDGE_THRESHOLD_R_MAX 31u
 
-/* OUTPUT_MODE (rw): What the Sobel unit streams and from which scale. */
+/* OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream. */
 #define STEREOCAL_OUTPUT_MODE_OFFSET 0x20u
 #define STEREOCAL_OUTPUT_MODE_RESET 0x00000011u
-/* [0:0] rw: Which Sobel entries reach SOBEL_OUT. */
+/* [0:0] rw: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO. */
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_SHIFT 0u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_WIDTH 1u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_MASK 0x00000001u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_RESET 0x1u
-#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_ROWS 0u /* Every pixel of the selected scale of octave 0 (full resolution), in raster order (FIRST marks each line start). */
-#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES 1u /* Only the 16x16 patch around each point, taken from the selected scale of the point's own octave, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start). */
-/* [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit. */
+#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_ROWS 0u /* The driver sends every row of every octave (SobelRows packets). */
+#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES 1u /* The driver cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the fabric still streams every pixel. */
+/* [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit in every octave (Config::sobel_scale). */
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_SHIFT 4u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_WIDTH 2u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_MASK 0x00000030u
@@ -163,13 +163,13 @@
 /* SOBEL_FIFO_LEVEL (ro): Fill level of the Sobel FIFO. */
 #define STEREOCAL_SOBEL_FIFO_LEVEL_OFFSET 0x28u
 #define STEREOCAL_SOBEL_FIFO_LEVEL_RESET 0x00000000u
-/* [15:0] ro, valid 0..4096: Entries waiting in the Sobel FIFO. */
+/* [15:0] ro, valid 0..3840: Entries waiting in the Sobel FIFO. */
 #define STEREOCAL_SOBEL_FIFO_LEVEL_LEVEL_SHIFT 0u
 #define STEREOCAL_SOBEL_FIFO_LEVEL_LEVEL_WIDTH 16u
 #define STEREOCAL_SOBEL_FIFO_LEVEL_LEVEL_MASK 0x0000FFFFu
 #define STEREOCAL_SOBEL_FIFO_LEVEL_LEVEL_RESET 0x0u
 #define STEREOCAL_SOBEL_FIFO_LEVEL_LEVEL_MIN 0u
-#define STEREOCAL_SOBEL_FIFO_LEVEL_LEVEL_MAX 4096u
+#define STEREOCAL_SOBEL_FIFO_LEVEL_LEVEL_MAX 3840u
 
 /* POINT_OVERFLOW_COUNT (ro): Points dropped on a full point FIFO since the last reset. */
 #define STEREOCAL_POINT_OVERFLOW_COUNT_OFFSET 0x2Cu
@@ -201,16 +201,16 @@
 /* LATENCY_CLOCKS (ro): Pipeline latency measured on the last frame. */
 #define STEREOCAL_LATENCY_CLOCKS_OFFSET 0x38u
 #define STEREOCAL_LATENCY_CLOCKS_RESET 0x00000000u
-/* [31:0] ro: Clocks from the first pixel accepted on PIXEL_IN to the first pixel of the last octave's first scale; 0 until a frame has reached the last octave. */
+/* [31:0] ro: Clocks from the first pixel accepted on PIXEL_IN to the first input sample of the last configured octave (OCTAVES.COUNT - 1; 0 clocks with one octave); 0 until a frame has reached the last octave. */
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_SHIFT 0u
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_WIDTH 32u
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_MASK 0xFFFFFFFFu
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_RESET 0x0u
 
-/* POINT_FIFO_DATA (ro): Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID. */
+/* POINT_FIFO_DATA (ro): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. */
 #define STEREOCAL_POINT_FIFO_DATA_OFFSET 0x3Cu
 #define STEREOCAL_POINT_FIFO_DATA_RESET 0x00000000u
-/* [10:0] ro: Column in the point's own octave (full-resolution column = X << (OCTAVE)). */
+/* [10:0] ro: Column in the point's own octave (full-resolution column = X << OCTAVE). */
 #define STEREOCAL_POINT_FIFO_DATA_X_SHIFT 0u
 #define STEREOCAL_POINT_FIFO_DATA_X_WIDTH 11u
 #define STEREOCAL_POINT_FIFO_DATA_X_MASK 0x000007FFu
@@ -225,45 +225,93 @@
 #define STEREOCAL_POINT_FIFO_DATA_OCTAVE_WIDTH 2u
 #define STEREOCAL_POINT_FIFO_DATA_OCTAVE_MASK 0x00C00000u
 #define STEREOCAL_POINT_FIFO_DATA_OCTAVE_RESET 0x0u
-/* [25:24] ro: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves. */
+/* [25:24] ro: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1. */
 #define STEREOCAL_POINT_FIFO_DATA_SCALE_SHIFT 24u
 #define STEREOCAL_POINT_FIFO_DATA_SCALE_WIDTH 2u
 #define STEREOCAL_POINT_FIFO_DATA_SCALE_MASK 0x03000000u
 #define STEREOCAL_POINT_FIFO_DATA_SCALE_RESET 0x0u
-/* [26:26] ro: 1: a maximum of the DoG, 0: a minimum. */
-#define STEREOCAL_POINT_FIFO_DATA_POLARITY_SHIFT 26u
-#define STEREOCAL_POINT_FIFO_DATA_POLARITY_WIDTH 1u
-#define STEREOCAL_POINT_FIFO_DATA_POLARITY_MASK 0x04000000u
-#define STEREOCAL_POINT_FIFO_DATA_POLARITY_RESET 0x0u
-/* [31:31] ro: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed. */
+/* [31:31] ro: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed and the holding registers read 0. */
 #define STEREOCAL_POINT_FIFO_DATA_VALID_SHIFT 31u
 #define STEREOCAL_POINT_FIFO_DATA_VALID_WIDTH 1u
 #define STEREOCAL_POINT_FIFO_DATA_VALID_MASK 0x80000000u
 #define STEREOCAL_POINT_FIFO_DATA_VALID_RESET 0x0u
 
-/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID. */
-#define STEREOCAL_SOBEL_FIFO_DATA_OFFSET 0x40u
+/* POINT_FIFO_DXDY (ro): Word 1 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect). */
+#define STEREOCAL_POINT_FIFO_DXDY_OFFSET 0x40u
+#define STEREOCAL_POINT_FIFO_DXDY_RESET 0x00000000u
+/* [15:0] ro: Sub-pixel column offset, Q2.13 two's complement (8192 = 1 pixel of the point's octave), |DX| <= MAX_OFFSET. */
+#define STEREOCAL_POINT_FIFO_DXDY_DX_SHIFT 0u
+#define STEREOCAL_POINT_FIFO_DXDY_DX_WIDTH 16u
+#define STEREOCAL_POINT_FIFO_DXDY_DX_MASK 0x0000FFFFu
+#define STEREOCAL_POINT_FIFO_DXDY_DX_RESET 0x0u
+/* [31:16] ro: Sub-pixel row offset, Q2.13 two's complement, |DY| <= MAX_OFFSET. */
+#define STEREOCAL_POINT_FIFO_DXDY_DY_SHIFT 16u
+#define STEREOCAL_POINT_FIFO_DXDY_DY_WIDTH 16u
+#define STEREOCAL_POINT_FIFO_DXDY_DY_MASK 0xFFFF0000u
+#define STEREOCAL_POINT_FIFO_DXDY_DY_RESET 0x0u
+
+/* POINT_FIFO_DSDOG (ro): Word 2 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect). */
+#define STEREOCAL_POINT_FIFO_DSDOG_OFFSET 0x44u
+#define STEREOCAL_POINT_FIFO_DSDOG_RESET 0x00000000u
+/* [15:0] ro: Sub-scale offset in DoG-level units, Q2.13 two's complement, |DS| <= MAX_OFFSET. */
+#define STEREOCAL_POINT_FIFO_DSDOG_DS_SHIFT 0u
+#define STEREOCAL_POINT_FIFO_DSDOG_DS_WIDTH 16u
+#define STEREOCAL_POINT_FIFO_DSDOG_DS_MASK 0x0000FFFFu
+#define STEREOCAL_POINT_FIFO_DSDOG_DS_RESET 0x0u
+/* [31:16] ro: DoG sample at the extremum, Q8.8 grey levels two's complement (i16): positive for a maximum, negative for a minimum. */
+#define STEREOCAL_POINT_FIFO_DSDOG_DOG_SHIFT 16u
+#define STEREOCAL_POINT_FIFO_DSDOG_DOG_WIDTH 16u
+#define STEREOCAL_POINT_FIFO_DSDOG_DOG_MASK 0xFFFF0000u
+#define STEREOCAL_POINT_FIFO_DSDOG_DOG_RESET 0x0u
+
+/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. */
+#define STEREOCAL_SOBEL_FIFO_DATA_OFFSET 0x48u
 #define STEREOCAL_SOBEL_FIFO_DATA_RESET 0x00000000u
-/* [7:0] ro: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits. */
+/* [7:0] ro: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs). */
 #define STEREOCAL_SOBEL_FIFO_DATA_MAGNITUDE_SHIFT 0u
 #define STEREOCAL_SOBEL_FIFO_DATA_MAGNITUDE_WIDTH 8u
 #define STEREOCAL_SOBEL_FIFO_DATA_MAGNITUDE_MASK 0x000000FFu
 #define STEREOCAL_SOBEL_FIFO_DATA_MAGNITUDE_RESET 0x0u
-/* [13:8] ro: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down). */
+/* [13:8] ro: Gradient direction in 1/64 turns (5.625 degrees): 0 along +x, increasing toward +y (image y points down). */
 #define STEREOCAL_SOBEL_FIFO_DATA_ORIENTATION_SHIFT 8u
 #define STEREOCAL_SOBEL_FIFO_DATA_ORIENTATION_WIDTH 6u
 #define STEREOCAL_SOBEL_FIFO_DATA_ORIENTATION_MASK 0x00003F00u
 #define STEREOCAL_SOBEL_FIFO_DATA_ORIENTATION_RESET 0x0u
-/* [14:14] ro: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES). */
-#define STEREOCAL_SOBEL_FIFO_DATA_FIRST_SHIFT 14u
-#define STEREOCAL_SOBEL_FIFO_DATA_FIRST_WIDTH 1u
-#define STEREOCAL_SOBEL_FIFO_DATA_FIRST_MASK 0x00004000u
-#define STEREOCAL_SOBEL_FIFO_DATA_FIRST_RESET 0x0u
-/* [31:31] ro: 1: the other fields hold a Sobel entry (and the read removed it). 0: the FIFO was empty; nothing was removed. */
+/* [15:14] ro: Octave of the pixel, 0 = full resolution. */
+#define STEREOCAL_SOBEL_FIFO_DATA_OCTAVE_SHIFT 14u
+#define STEREOCAL_SOBEL_FIFO_DATA_OCTAVE_WIDTH 2u
+#define STEREOCAL_SOBEL_FIFO_DATA_OCTAVE_MASK 0x0000C000u
+#define STEREOCAL_SOBEL_FIFO_DATA_OCTAVE_RESET 0x0u
+/* [31:31] ro: 1: the other fields hold a Sobel pixel (and the read removed it). 0: the FIFO was empty; nothing was removed and SOBEL_FIFO_POSITION reads 0. */
 #define STEREOCAL_SOBEL_FIFO_DATA_VALID_SHIFT 31u
 #define STEREOCAL_SOBEL_FIFO_DATA_VALID_WIDTH 1u
 #define STEREOCAL_SOBEL_FIFO_DATA_VALID_MASK 0x80000000u
 #define STEREOCAL_SOBEL_FIFO_DATA_VALID_RESET 0x0u
+
+/* SOBEL_FIFO_POSITION (ro): Word 1 of the Sobel pixel last popped from SOBEL_FIFO_DATA (a holding register: reading it has no side effect). */
+#define STEREOCAL_SOBEL_FIFO_POSITION_OFFSET 0x4Cu
+#define STEREOCAL_SOBEL_FIFO_POSITION_RESET 0x00000000u
+/* [15:0] ro: Column in the pixel's own octave. */
+#define STEREOCAL_SOBEL_FIFO_POSITION_X_SHIFT 0u
+#define STEREOCAL_SOBEL_FIFO_POSITION_X_WIDTH 16u
+#define STEREOCAL_SOBEL_FIFO_POSITION_X_MASK 0x0000FFFFu
+#define STEREOCAL_SOBEL_FIFO_POSITION_X_RESET 0x0u
+/* [31:16] ro: Row in the pixel's own octave. */
+#define STEREOCAL_SOBEL_FIFO_POSITION_Y_SHIFT 16u
+#define STEREOCAL_SOBEL_FIFO_POSITION_Y_WIDTH 16u
+#define STEREOCAL_SOBEL_FIFO_POSITION_Y_MASK 0xFFFF0000u
+#define STEREOCAL_SOBEL_FIFO_POSITION_Y_RESET 0x0u
+
+/* MAX_OFFSET (rw): Bound of the sub-pixel refinement (Config::max_offset of the model). */
+#define STEREOCAL_MAX_OFFSET_OFFSET 0x50u
+#define STEREOCAL_MAX_OFFSET_RESET 0x00001000u
+/* [15:0] rw, valid 0..8191: Largest accepted |offset| per axis (x, y, scale), raw Q2.13: a refined extremum with any larger offset is dropped. 4096 = 0.5 sample; must stay below 8192 (1.0). */
+#define STEREOCAL_MAX_OFFSET_VALUE_SHIFT 0u
+#define STEREOCAL_MAX_OFFSET_VALUE_WIDTH 16u
+#define STEREOCAL_MAX_OFFSET_VALUE_MASK 0x0000FFFFu
+#define STEREOCAL_MAX_OFFSET_VALUE_RESET 0x1000u
+#define STEREOCAL_MAX_OFFSET_VALUE_MIN 0u
+#define STEREOCAL_MAX_OFFSET_VALUE_MAX 8191u
 
 /* Stream port PIXEL_IN (in): Camera pixels, raster order, at most one per clock. */
 #define STEREOCAL_PORT_PIXEL_IN_DATA_WIDTH 8u
@@ -271,39 +319,5 @@
 #define STEREOCAL_PORT_PIXEL_IN_READY_WIDTH 1u
 #define STEREOCAL_PORT_PIXEL_IN_SOF_WIDTH 1u
 #define STEREOCAL_PORT_PIXEL_IN_EOL_WIDTH 1u
-
-/* Stream port POINT_OUT (out): Detected scale-space extrema, into the point FIFO. */
-#define STEREOCAL_PORT_POINT_OUT_DATA_WIDTH 27u
-#define STEREOCAL_PORT_POINT_OUT_VALID_WIDTH 1u
-#define STEREOCAL_PORT_POINT_OUT_READY_WIDTH 1u
-#define STEREOCAL_PORT_POINT_OUT_X_SHIFT 0u
-#define STEREOCAL_PORT_POINT_OUT_X_WIDTH 11u
-#define STEREOCAL_PORT_POINT_OUT_X_MASK 0x000007FFu
-#define STEREOCAL_PORT_POINT_OUT_Y_SHIFT 11u
-#define STEREOCAL_PORT_POINT_OUT_Y_WIDTH 11u
-#define STEREOCAL_PORT_POINT_OUT_Y_MASK 0x003FF800u
-#define STEREOCAL_PORT_POINT_OUT_OCTAVE_SHIFT 22u
-#define STEREOCAL_PORT_POINT_OUT_OCTAVE_WIDTH 2u
-#define STEREOCAL_PORT_POINT_OUT_OCTAVE_MASK 0x00C00000u
-#define STEREOCAL_PORT_POINT_OUT_SCALE_SHIFT 24u
-#define STEREOCAL_PORT_POINT_OUT_SCALE_WIDTH 2u
-#define STEREOCAL_PORT_POINT_OUT_SCALE_MASK 0x03000000u
-#define STEREOCAL_PORT_POINT_OUT_POLARITY_SHIFT 26u
-#define STEREOCAL_PORT_POINT_OUT_POLARITY_WIDTH 1u
-#define STEREOCAL_PORT_POINT_OUT_POLARITY_MASK 0x04000000u
-
-/* Stream port SOBEL_OUT (out): Gradient magnitude and orientation from the Sobel/CORDIC unit, into the Sobel FIFO. */
-#define STEREOCAL_PORT_SOBEL_OUT_DATA_WIDTH 15u
-#define STEREOCAL_PORT_SOBEL_OUT_VALID_WIDTH 1u
-#define STEREOCAL_PORT_SOBEL_OUT_READY_WIDTH 1u
-#define STEREOCAL_PORT_SOBEL_OUT_MAGNITUDE_SHIFT 0u
-#define STEREOCAL_PORT_SOBEL_OUT_MAGNITUDE_WIDTH 8u
-#define STEREOCAL_PORT_SOBEL_OUT_MAGNITUDE_MASK 0x000000FFu
-#define STEREOCAL_PORT_SOBEL_OUT_ORIENTATION_SHIFT 8u
-#define STEREOCAL_PORT_SOBEL_OUT_ORIENTATION_WIDTH 6u
-#define STEREOCAL_PORT_SOBEL_OUT_ORIENTATION_MASK 0x00003F00u
-#define STEREOCAL_PORT_SOBEL_OUT_FIRST_SHIFT 14u
-#define STEREOCAL_PORT_SOBEL_OUT_FIRST_WIDTH 1u
-#define STEREOCAL_PORT_SOBEL_OUT_FIRST_MASK 0x00004000u
 
 #endif /* STEREOCAL_REGS_H */

@@ -7,18 +7,18 @@ localparam [31:0] SC_BASE_ADDR = 32'h40000000;
 localparam integer SC_WINDOW_SIZE = 256;
 localparam integer SC_OFFSET_BITS = 8;
 localparam integer SC_REGISTER_WIDTH = 32;
-localparam [7:0] SC_VERSION_MAJOR = 8'd1;
+localparam [7:0] SC_VERSION_MAJOR = 8'd2;
 localparam [7:0] SC_VERSION_MINOR = 8'd0;
 localparam integer SC_MAX_HEIGHT = 1024;
 localparam integer SC_MAX_OCTAVES = 4;
 localparam integer SC_MAX_WIDTH = 1280;
 localparam integer SC_MIN_SIDE = 16;
 localparam integer SC_POINT_FIFO_DEPTH = 512;
-localparam integer SC_SOBEL_FIFO_DEPTH = 4096;
+localparam integer SC_SOBEL_FIFO_DEPTH = 3840;
 
 // VERSION (ro): Identifies the fabric and the register-map version it implements.
 localparam [7:0] SC_VERSION_OFFSET = 8'h00;
-localparam [31:0] SC_VERSION_RESET = 32'h5C010100;
+localparam [31:0] SC_VERSION_RESET = 32'h5C010200;
 // [7:0] ro: Register-map minor version (additive changes only).
 localparam integer SC_VERSION_MINOR_LSB = 0;
 localparam integer SC_VERSION_MINOR_MSB = 7;
@@ -30,7 +30,7 @@ localparam integer SC_VERSION_MAJOR_LSB = 8;
 localparam integer SC_VERSION_MAJOR_MSB = 15;
 localparam integer SC_VERSION_MAJOR_WIDTH = 8;
 localparam [31:0] SC_VERSION_MAJOR_MASK = 32'h0000FF00;
-localparam [7:0] SC_VERSION_MAJOR_RESET = 8'h1;
+localparam [7:0] SC_VERSION_MAJOR_RESET = 8'h2;
 // [31:16] ro: Constant 0x5C01: a read of anything else means no stereocal fabric at this address.
 localparam integer SC_VERSION_MAGIC_LSB = 16;
 localparam integer SC_VERSION_MAGIC_MSB = 31;
@@ -41,7 +41,7 @@ localparam [15:0] SC_VERSION_MAGIC_RESET = 16'h5C01;
 // CONTROL (rw): Run control. Configuration registers are sampled at each start of frame.
 localparam [7:0] SC_CONTROL_OFFSET = 8'h04;
 localparam [31:0] SC_CONTROL_RESET = 32'h00000000;
-// [0:0] rw: 1: the pipeline runs. 0: PIXEL_IN ready is held low and no stage advances.
+// [0:0] rw: 1: the pipeline takes pixels. 0: PIXEL_IN ready is held low (a frame already taken keeps flushing its last rows through the octaves).
 localparam integer SC_CONTROL_ENABLE_LSB = 0;
 localparam integer SC_CONTROL_ENABLE_MSB = 0;
 localparam integer SC_CONTROL_ENABLE_WIDTH = 1;
@@ -118,15 +118,15 @@ localparam integer SC_OCTAVES_COUNT_WIDTH = 3;
 localparam [31:0] SC_OCTAVES_COUNT_MASK = 32'h00000007;
 localparam [2:0] SC_OCTAVES_COUNT_RESET = 3'h4;
 
-// CONTRAST_THRESHOLD (rw): Low-contrast rejection of extrema.
+// CONTRAST_THRESHOLD (rw): Low-contrast rejection of extrema (Config::contrast_threshold of the model).
 localparam [7:0] SC_CONTRAST_THRESHOLD_OFFSET = 8'h18;
-localparam [31:0] SC_CONTRAST_THRESHOLD_RESET = 32'h00000008;
-// [7:0] rw: An extremum is kept only if |DoG| >= VALUE. DoG units are grey levels of the 8-bit smoothed images (a DoG sample is the difference of two of them, -255..255); 8 is about Lowe's 0.03 of full scale.
+localparam [31:0] SC_CONTRAST_THRESHOLD_RESET = 32'h00000800;
+// [15:0] rw: Q8.8 grey levels (256 = 1.0 grey level): an extremum is kept only if its DoG sample is a strict maximum above VALUE or a strict minimum below -VALUE. DoG samples are differences of two Q8.8 smoothed images. The reset 0x0800 (8.0 grey levels, about Lowe's 0.03 of full scale) is v1's reset of 8 whole grey levels; the model's Config::new and the host's session use 0x0100 (1.0).
 localparam integer SC_CONTRAST_THRESHOLD_VALUE_LSB = 0;
-localparam integer SC_CONTRAST_THRESHOLD_VALUE_MSB = 7;
-localparam integer SC_CONTRAST_THRESHOLD_VALUE_WIDTH = 8;
-localparam [31:0] SC_CONTRAST_THRESHOLD_VALUE_MASK = 32'h000000FF;
-localparam [7:0] SC_CONTRAST_THRESHOLD_VALUE_RESET = 8'h8;
+localparam integer SC_CONTRAST_THRESHOLD_VALUE_MSB = 15;
+localparam integer SC_CONTRAST_THRESHOLD_VALUE_WIDTH = 16;
+localparam [31:0] SC_CONTRAST_THRESHOLD_VALUE_MASK = 32'h0000FFFF;
+localparam [15:0] SC_CONTRAST_THRESHOLD_VALUE_RESET = 16'h800;
 
 // EDGE_THRESHOLD (rw): Edge-response rejection of extrema (Lowe's principal-curvature ratio).
 localparam [7:0] SC_EDGE_THRESHOLD_OFFSET = 8'h1C;
@@ -138,18 +138,18 @@ localparam integer SC_EDGE_THRESHOLD_R_WIDTH = 5;
 localparam [31:0] SC_EDGE_THRESHOLD_R_MASK = 32'h0000001F;
 localparam [4:0] SC_EDGE_THRESHOLD_R_RESET = 5'hA;
 
-// OUTPUT_MODE (rw): What the Sobel unit streams and from which scale.
+// OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream.
 localparam [7:0] SC_OUTPUT_MODE_OFFSET = 8'h20;
 localparam [31:0] SC_OUTPUT_MODE_RESET = 32'h00000011;
-// [0:0] rw: Which Sobel entries reach SOBEL_OUT.
+// [0:0] rw: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_LSB = 0;
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_MSB = 0;
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_WIDTH = 1;
 localparam [31:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_MASK = 32'h00000001;
 localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_RESET = 1'h1;
-localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_ROWS = 1'd0; // Every pixel of the selected scale of octave 0 (full resolution), in raster order (FIRST marks each line start).
-localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES = 1'd1; // Only the 16x16 patch around each point, taken from the selected scale of the point's own octave, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start).
-// [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit.
+localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_ROWS = 1'd0; // The driver sends every row of every octave (SobelRows packets).
+localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES = 1'd1; // The driver cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the fabric still streams every pixel.
+// [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit in every octave (Config::sobel_scale).
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_LSB = 4;
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_MSB = 5;
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_WIDTH = 2;
@@ -169,7 +169,7 @@ localparam [15:0] SC_POINT_FIFO_LEVEL_LEVEL_RESET = 16'h0;
 // SOBEL_FIFO_LEVEL (ro): Fill level of the Sobel FIFO.
 localparam [7:0] SC_SOBEL_FIFO_LEVEL_OFFSET = 8'h28;
 localparam [31:0] SC_SOBEL_FIFO_LEVEL_RESET = 32'h00000000;
-// [15:0] ro, valid 0..4096: Entries waiting in the Sobel FIFO.
+// [15:0] ro, valid 0..3840: Entries waiting in the Sobel FIFO.
 localparam integer SC_SOBEL_FIFO_LEVEL_LEVEL_LSB = 0;
 localparam integer SC_SOBEL_FIFO_LEVEL_LEVEL_MSB = 15;
 localparam integer SC_SOBEL_FIFO_LEVEL_LEVEL_WIDTH = 16;
@@ -209,17 +209,17 @@ localparam [31:0] SC_FRAME_COUNT_COUNT_RESET = 32'h0;
 // LATENCY_CLOCKS (ro): Pipeline latency measured on the last frame.
 localparam [7:0] SC_LATENCY_CLOCKS_OFFSET = 8'h38;
 localparam [31:0] SC_LATENCY_CLOCKS_RESET = 32'h00000000;
-// [31:0] ro: Clocks from the first pixel accepted on PIXEL_IN to the first pixel of the last octave's first scale; 0 until a frame has reached the last octave.
+// [31:0] ro: Clocks from the first pixel accepted on PIXEL_IN to the first input sample of the last configured octave (OCTAVES.COUNT - 1; 0 clocks with one octave); 0 until a frame has reached the last octave.
 localparam integer SC_LATENCY_CLOCKS_CLOCKS_LSB = 0;
 localparam integer SC_LATENCY_CLOCKS_CLOCKS_MSB = 31;
 localparam integer SC_LATENCY_CLOCKS_CLOCKS_WIDTH = 32;
 localparam [31:0] SC_LATENCY_CLOCKS_CLOCKS_MASK = 32'hFFFFFFFF;
 localparam [31:0] SC_LATENCY_CLOCKS_CLOCKS_RESET = 32'h0;
 
-// POINT_FIFO_DATA (ro, read pops): Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID.
+// POINT_FIFO_DATA (ro, read pops): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop.
 localparam [7:0] SC_POINT_FIFO_DATA_OFFSET = 8'h3C;
 localparam [31:0] SC_POINT_FIFO_DATA_RESET = 32'h00000000;
-// [10:0] ro: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
+// [10:0] ro: Column in the point's own octave (full-resolution column = X << OCTAVE).
 localparam integer SC_POINT_FIFO_DATA_X_LSB = 0;
 localparam integer SC_POINT_FIFO_DATA_X_MSB = 10;
 localparam integer SC_POINT_FIFO_DATA_X_WIDTH = 11;
@@ -237,99 +237,109 @@ localparam integer SC_POINT_FIFO_DATA_OCTAVE_MSB = 23;
 localparam integer SC_POINT_FIFO_DATA_OCTAVE_WIDTH = 2;
 localparam [31:0] SC_POINT_FIFO_DATA_OCTAVE_MASK = 32'h00C00000;
 localparam [1:0] SC_POINT_FIFO_DATA_OCTAVE_RESET = 2'h0;
-// [25:24] ro: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
+// [25:24] ro: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1.
 localparam integer SC_POINT_FIFO_DATA_SCALE_LSB = 24;
 localparam integer SC_POINT_FIFO_DATA_SCALE_MSB = 25;
 localparam integer SC_POINT_FIFO_DATA_SCALE_WIDTH = 2;
 localparam [31:0] SC_POINT_FIFO_DATA_SCALE_MASK = 32'h03000000;
 localparam [1:0] SC_POINT_FIFO_DATA_SCALE_RESET = 2'h0;
-// [26:26] ro: 1: a maximum of the DoG, 0: a minimum.
-localparam integer SC_POINT_FIFO_DATA_POLARITY_LSB = 26;
-localparam integer SC_POINT_FIFO_DATA_POLARITY_MSB = 26;
-localparam integer SC_POINT_FIFO_DATA_POLARITY_WIDTH = 1;
-localparam [31:0] SC_POINT_FIFO_DATA_POLARITY_MASK = 32'h04000000;
-localparam [0:0] SC_POINT_FIFO_DATA_POLARITY_RESET = 1'h0;
-// [31:31] ro: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed.
+// [31:31] ro: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed and the holding registers read 0.
 localparam integer SC_POINT_FIFO_DATA_VALID_LSB = 31;
 localparam integer SC_POINT_FIFO_DATA_VALID_MSB = 31;
 localparam integer SC_POINT_FIFO_DATA_VALID_WIDTH = 1;
 localparam [31:0] SC_POINT_FIFO_DATA_VALID_MASK = 32'h80000000;
 localparam [0:0] SC_POINT_FIFO_DATA_VALID_RESET = 1'h0;
 
-// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID.
-localparam [7:0] SC_SOBEL_FIFO_DATA_OFFSET = 8'h40;
+// POINT_FIFO_DXDY (ro): Word 1 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect).
+localparam [7:0] SC_POINT_FIFO_DXDY_OFFSET = 8'h40;
+localparam [31:0] SC_POINT_FIFO_DXDY_RESET = 32'h00000000;
+// [15:0] ro: Sub-pixel column offset, Q2.13 two's complement (8192 = 1 pixel of the point's octave), |DX| <= MAX_OFFSET.
+localparam integer SC_POINT_FIFO_DXDY_DX_LSB = 0;
+localparam integer SC_POINT_FIFO_DXDY_DX_MSB = 15;
+localparam integer SC_POINT_FIFO_DXDY_DX_WIDTH = 16;
+localparam [31:0] SC_POINT_FIFO_DXDY_DX_MASK = 32'h0000FFFF;
+localparam [15:0] SC_POINT_FIFO_DXDY_DX_RESET = 16'h0;
+// [31:16] ro: Sub-pixel row offset, Q2.13 two's complement, |DY| <= MAX_OFFSET.
+localparam integer SC_POINT_FIFO_DXDY_DY_LSB = 16;
+localparam integer SC_POINT_FIFO_DXDY_DY_MSB = 31;
+localparam integer SC_POINT_FIFO_DXDY_DY_WIDTH = 16;
+localparam [31:0] SC_POINT_FIFO_DXDY_DY_MASK = 32'hFFFF0000;
+localparam [15:0] SC_POINT_FIFO_DXDY_DY_RESET = 16'h0;
+
+// POINT_FIFO_DSDOG (ro): Word 2 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect).
+localparam [7:0] SC_POINT_FIFO_DSDOG_OFFSET = 8'h44;
+localparam [31:0] SC_POINT_FIFO_DSDOG_RESET = 32'h00000000;
+// [15:0] ro: Sub-scale offset in DoG-level units, Q2.13 two's complement, |DS| <= MAX_OFFSET.
+localparam integer SC_POINT_FIFO_DSDOG_DS_LSB = 0;
+localparam integer SC_POINT_FIFO_DSDOG_DS_MSB = 15;
+localparam integer SC_POINT_FIFO_DSDOG_DS_WIDTH = 16;
+localparam [31:0] SC_POINT_FIFO_DSDOG_DS_MASK = 32'h0000FFFF;
+localparam [15:0] SC_POINT_FIFO_DSDOG_DS_RESET = 16'h0;
+// [31:16] ro: DoG sample at the extremum, Q8.8 grey levels two's complement (i16): positive for a maximum, negative for a minimum.
+localparam integer SC_POINT_FIFO_DSDOG_DOG_LSB = 16;
+localparam integer SC_POINT_FIFO_DSDOG_DOG_MSB = 31;
+localparam integer SC_POINT_FIFO_DSDOG_DOG_WIDTH = 16;
+localparam [31:0] SC_POINT_FIFO_DSDOG_DOG_MASK = 32'hFFFF0000;
+localparam [15:0] SC_POINT_FIFO_DSDOG_DOG_RESET = 16'h0;
+
+// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
+localparam [7:0] SC_SOBEL_FIFO_DATA_OFFSET = 8'h48;
 localparam [31:0] SC_SOBEL_FIFO_DATA_RESET = 32'h00000000;
-// [7:0] ro: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
+// [7:0] ro: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs).
 localparam integer SC_SOBEL_FIFO_DATA_MAGNITUDE_LSB = 0;
 localparam integer SC_SOBEL_FIFO_DATA_MAGNITUDE_MSB = 7;
 localparam integer SC_SOBEL_FIFO_DATA_MAGNITUDE_WIDTH = 8;
 localparam [31:0] SC_SOBEL_FIFO_DATA_MAGNITUDE_MASK = 32'h000000FF;
 localparam [7:0] SC_SOBEL_FIFO_DATA_MAGNITUDE_RESET = 8'h0;
-// [13:8] ro: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
+// [13:8] ro: Gradient direction in 1/64 turns (5.625 degrees): 0 along +x, increasing toward +y (image y points down).
 localparam integer SC_SOBEL_FIFO_DATA_ORIENTATION_LSB = 8;
 localparam integer SC_SOBEL_FIFO_DATA_ORIENTATION_MSB = 13;
 localparam integer SC_SOBEL_FIFO_DATA_ORIENTATION_WIDTH = 6;
 localparam [31:0] SC_SOBEL_FIFO_DATA_ORIENTATION_MASK = 32'h00003F00;
 localparam [5:0] SC_SOBEL_FIFO_DATA_ORIENTATION_RESET = 6'h0;
-// [14:14] ro: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
-localparam integer SC_SOBEL_FIFO_DATA_FIRST_LSB = 14;
-localparam integer SC_SOBEL_FIFO_DATA_FIRST_MSB = 14;
-localparam integer SC_SOBEL_FIFO_DATA_FIRST_WIDTH = 1;
-localparam [31:0] SC_SOBEL_FIFO_DATA_FIRST_MASK = 32'h00004000;
-localparam [0:0] SC_SOBEL_FIFO_DATA_FIRST_RESET = 1'h0;
-// [31:31] ro: 1: the other fields hold a Sobel entry (and the read removed it). 0: the FIFO was empty; nothing was removed.
+// [15:14] ro: Octave of the pixel, 0 = full resolution.
+localparam integer SC_SOBEL_FIFO_DATA_OCTAVE_LSB = 14;
+localparam integer SC_SOBEL_FIFO_DATA_OCTAVE_MSB = 15;
+localparam integer SC_SOBEL_FIFO_DATA_OCTAVE_WIDTH = 2;
+localparam [31:0] SC_SOBEL_FIFO_DATA_OCTAVE_MASK = 32'h0000C000;
+localparam [1:0] SC_SOBEL_FIFO_DATA_OCTAVE_RESET = 2'h0;
+// [31:31] ro: 1: the other fields hold a Sobel pixel (and the read removed it). 0: the FIFO was empty; nothing was removed and SOBEL_FIFO_POSITION reads 0.
 localparam integer SC_SOBEL_FIFO_DATA_VALID_LSB = 31;
 localparam integer SC_SOBEL_FIFO_DATA_VALID_MSB = 31;
 localparam integer SC_SOBEL_FIFO_DATA_VALID_WIDTH = 1;
 localparam [31:0] SC_SOBEL_FIFO_DATA_VALID_MASK = 32'h80000000;
 localparam [0:0] SC_SOBEL_FIFO_DATA_VALID_RESET = 1'h0;
 
+// SOBEL_FIFO_POSITION (ro): Word 1 of the Sobel pixel last popped from SOBEL_FIFO_DATA (a holding register: reading it has no side effect).
+localparam [7:0] SC_SOBEL_FIFO_POSITION_OFFSET = 8'h4C;
+localparam [31:0] SC_SOBEL_FIFO_POSITION_RESET = 32'h00000000;
+// [15:0] ro: Column in the pixel's own octave.
+localparam integer SC_SOBEL_FIFO_POSITION_X_LSB = 0;
+localparam integer SC_SOBEL_FIFO_POSITION_X_MSB = 15;
+localparam integer SC_SOBEL_FIFO_POSITION_X_WIDTH = 16;
+localparam [31:0] SC_SOBEL_FIFO_POSITION_X_MASK = 32'h0000FFFF;
+localparam [15:0] SC_SOBEL_FIFO_POSITION_X_RESET = 16'h0;
+// [31:16] ro: Row in the pixel's own octave.
+localparam integer SC_SOBEL_FIFO_POSITION_Y_LSB = 16;
+localparam integer SC_SOBEL_FIFO_POSITION_Y_MSB = 31;
+localparam integer SC_SOBEL_FIFO_POSITION_Y_WIDTH = 16;
+localparam [31:0] SC_SOBEL_FIFO_POSITION_Y_MASK = 32'hFFFF0000;
+localparam [15:0] SC_SOBEL_FIFO_POSITION_Y_RESET = 16'h0;
+
+// MAX_OFFSET (rw): Bound of the sub-pixel refinement (Config::max_offset of the model).
+localparam [7:0] SC_MAX_OFFSET_OFFSET = 8'h50;
+localparam [31:0] SC_MAX_OFFSET_RESET = 32'h00001000;
+// [15:0] rw, valid 0..8191: Largest accepted |offset| per axis (x, y, scale), raw Q2.13: a refined extremum with any larger offset is dropped. 4096 = 0.5 sample; must stay below 8192 (1.0).
+localparam integer SC_MAX_OFFSET_VALUE_LSB = 0;
+localparam integer SC_MAX_OFFSET_VALUE_MSB = 15;
+localparam integer SC_MAX_OFFSET_VALUE_WIDTH = 16;
+localparam [31:0] SC_MAX_OFFSET_VALUE_MASK = 32'h0000FFFF;
+localparam [15:0] SC_MAX_OFFSET_VALUE_RESET = 16'h1000;
+
 // Stream port PIXEL_IN (in): Camera pixels, raster order, at most one per clock.
 localparam integer SC_PIXEL_IN_DATA_WIDTH = 8; // in: 8-bit grey level.
 localparam integer SC_PIXEL_IN_VALID_WIDTH = 1; // in: DATA, SOF and EOL hold a pixel.
 localparam integer SC_PIXEL_IN_READY_WIDTH = 1; // out: The fabric takes the pixel on this clock.
 localparam integer SC_PIXEL_IN_SOF_WIDTH = 1; // in: Start of frame: this pixel is (0, 0).
-localparam integer SC_PIXEL_IN_EOL_WIDTH = 1; // in: End of line: this pixel is the last of its line.
-
-// Stream port POINT_OUT (out): Detected scale-space extrema, into the point FIFO.
-localparam integer SC_POINT_OUT_DATA_WIDTH = 27; // out: One point, laid out as below.
-localparam integer SC_POINT_OUT_VALID_WIDTH = 1; // out: DATA holds a point.
-localparam integer SC_POINT_OUT_READY_WIDTH = 1; // in: The FIFO has room; when 0 the point is dropped and counted.
-// DATA[10:0]: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
-localparam integer SC_POINT_OUT_X_LSB = 0;
-localparam integer SC_POINT_OUT_X_MSB = 10;
-localparam integer SC_POINT_OUT_X_WIDTH = 11;
-// DATA[21:11]: Row in the point's own octave.
-localparam integer SC_POINT_OUT_Y_LSB = 11;
-localparam integer SC_POINT_OUT_Y_MSB = 21;
-localparam integer SC_POINT_OUT_Y_WIDTH = 11;
-// DATA[23:22]: Octave index, 0 = full resolution.
-localparam integer SC_POINT_OUT_OCTAVE_LSB = 22;
-localparam integer SC_POINT_OUT_OCTAVE_MSB = 23;
-localparam integer SC_POINT_OUT_OCTAVE_WIDTH = 2;
-// DATA[25:24]: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
-localparam integer SC_POINT_OUT_SCALE_LSB = 24;
-localparam integer SC_POINT_OUT_SCALE_MSB = 25;
-localparam integer SC_POINT_OUT_SCALE_WIDTH = 2;
-// DATA[26:26]: 1: a maximum of the DoG, 0: a minimum.
-localparam integer SC_POINT_OUT_POLARITY_LSB = 26;
-localparam integer SC_POINT_OUT_POLARITY_MSB = 26;
-localparam integer SC_POINT_OUT_POLARITY_WIDTH = 1;
-
-// Stream port SOBEL_OUT (out): Gradient magnitude and orientation from the Sobel/CORDIC unit, into the Sobel FIFO.
-localparam integer SC_SOBEL_OUT_DATA_WIDTH = 15; // out: One gradient sample, laid out as below.
-localparam integer SC_SOBEL_OUT_VALID_WIDTH = 1; // out: DATA holds a sample.
-localparam integer SC_SOBEL_OUT_READY_WIDTH = 1; // in: The FIFO has room; when 0 the sample is dropped and counted.
-// DATA[7:0]: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
-localparam integer SC_SOBEL_OUT_MAGNITUDE_LSB = 0;
-localparam integer SC_SOBEL_OUT_MAGNITUDE_MSB = 7;
-localparam integer SC_SOBEL_OUT_MAGNITUDE_WIDTH = 8;
-// DATA[13:8]: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
-localparam integer SC_SOBEL_OUT_ORIENTATION_LSB = 8;
-localparam integer SC_SOBEL_OUT_ORIENTATION_MSB = 13;
-localparam integer SC_SOBEL_OUT_ORIENTATION_WIDTH = 6;
-// DATA[14:14]: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
-localparam integer SC_SOBEL_OUT_FIRST_LSB = 14;
-localparam integer SC_SOBEL_OUT_FIRST_MSB = 14;
-localparam integer SC_SOBEL_OUT_FIRST_WIDTH = 1;
+localparam integer SC_PIXEL_IN_EOL_WIDTH = 1; // in: End of line: this pixel is the last of its line. The fabric counts lines by WIDTH and does not check EOL.
 // verilator lint_on UNUSEDPARAM

@@ -1,7 +1,7 @@
 //! The fabric's configuration as one typed value: what the driver writes and the model reads.
 
 use crate::regs::output_mode::{self, SobelOutput};
-use crate::regs::{contrast_threshold, edge_threshold, height, octaves, width};
+use crate::regs::{contrast_threshold, edge_threshold, height, max_offset, octaves, width};
 use crate::{Error, RegisterBus};
 
 /// Everything the driver sets before arming a frame. [`FabricConfig::default`] is the reset
@@ -14,14 +14,17 @@ pub struct FabricConfig {
     pub height: u16,
     /// Octaves, `1..=MAX_OCTAVES`.
     pub octaves: u8,
-    /// Minimum |DoG| of a kept extremum, in grey levels.
-    pub contrast_threshold: u8,
+    /// Contrast threshold of a kept extremum, Q8.8 grey levels (256 = 1.0): the model's
+    /// `Config::contrast_threshold`, unchanged.
+    pub contrast_threshold: u16,
     /// Lowe's principal-curvature ratio r, `1..=31`.
     pub edge_ratio: u8,
     /// Sobel rows or 16x16 patches.
     pub sobel_output: SobelOutput,
     /// Gaussian scale feeding the Sobel unit, `0..=3`.
     pub sobel_scale: u8,
+    /// Largest accepted refinement offset per axis, raw Q2.13, `0..=8191` (4096 = 0.5).
+    pub max_offset: u16,
 }
 
 impl Default for FabricConfig {
@@ -30,10 +33,11 @@ impl Default for FabricConfig {
             width: width::VALUE.reset as u16,
             height: height::VALUE.reset as u16,
             octaves: octaves::COUNT.reset as u8,
-            contrast_threshold: contrast_threshold::VALUE.reset as u8,
+            contrast_threshold: contrast_threshold::VALUE.reset as u16,
             edge_ratio: edge_threshold::R.reset as u8,
             sobel_output: output_mode::SOBEL_OUTPUT_RESET,
             sobel_scale: output_mode::SOBEL_SCALE.reset as u8,
+            max_offset: max_offset::VALUE.reset as u16,
         }
     }
 }
@@ -47,6 +51,7 @@ impl FabricConfig {
         contrast_threshold::VALUE.check(self.contrast_threshold.into())?;
         edge_threshold::R.check(self.edge_ratio.into())?;
         output_mode::SOBEL_SCALE.check(self.sobel_scale.into())?;
+        max_offset::VALUE.check(self.max_offset.into())?;
         // `octaves` is in 1..=MAX_OCTAVES here, so the shift is small.
         let step = 1u16 << (self.octaves - 1);
         if self.width % step != 0 || self.height % step != 0 {
@@ -71,6 +76,7 @@ impl FabricConfig {
         let mode = output_mode::SOBEL_OUTPUT.insert(0, self.sobel_output.bits())?;
         let mode = output_mode::SOBEL_SCALE.insert(mode, self.sobel_scale.into())?;
         bus.write(output_mode::OFFSET, mode);
+        bus.write_field(&max_offset::VALUE, self.max_offset.into())?;
         Ok(())
     }
 
@@ -95,6 +101,7 @@ impl FabricConfig {
                 &output_mode::SOBEL_SCALE,
                 output_mode::SOBEL_SCALE.extract(mode),
             )?,
+            max_offset: narrow(&max_offset::VALUE, bus.read_field(&max_offset::VALUE))?,
         };
         config.validate()?;
         Ok(config)
@@ -133,10 +140,11 @@ mod tests {
             width: 1280,
             height: 1024,
             octaves: 3,
-            contrast_threshold: 12,
+            contrast_threshold: 0x0C80,
             edge_ratio: 12,
             sobel_output: SobelOutput::Rows,
             sobel_scale: 2,
+            max_offset: 8191,
         };
         config.write_to(&mut bank).unwrap();
         assert_eq!(FabricConfig::read_from(&mut bank), Ok(config));
@@ -165,6 +173,18 @@ mod tests {
             zero_octaves.write_to(&mut bank),
             Err(Error::FieldOutOfRange {
                 field: "OCTAVES.COUNT",
+                ..
+            })
+        ));
+        let far = FabricConfig {
+            max_offset: 8192,
+            ..FabricConfig::default()
+        };
+        assert!(matches!(
+            far.write_to(&mut bank),
+            Err(Error::FieldOutOfRange {
+                field: "MAX_OFFSET.VALUE",
+                value: 8192,
                 ..
             })
         ));

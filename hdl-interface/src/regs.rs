@@ -13,7 +13,7 @@ pub const WINDOW_SIZE: u32 = 0x100;
 /// Bits per register.
 pub const REGISTER_WIDTH: u32 = 32;
 /// Register-map version this crate was generated for (VERSION.MAJOR / VERSION.MINOR).
-pub const VERSION_MAJOR: u32 = 1;
+pub const VERSION_MAJOR: u32 = 2;
 pub const VERSION_MINOR: u32 = 0;
 /// Synthesis parameter `max_height` of the description.
 pub const MAX_HEIGHT: u32 = 1024;
@@ -26,7 +26,7 @@ pub const MIN_SIDE: u32 = 16;
 /// Synthesis parameter `point_fifo_depth` of the description.
 pub const POINT_FIFO_DEPTH: u32 = 512;
 /// Synthesis parameter `sobel_fifo_depth` of the description.
-pub const SOBEL_FIFO_DEPTH: u32 = 4096;
+pub const SOBEL_FIFO_DEPTH: u32 = 3840;
 
 /// Identifies the fabric and the register-map version it implements. Offset 0x00, ro.
 pub mod version {
@@ -35,7 +35,7 @@ pub mod version {
     /// Byte offset from [`super::BASE_ADDRESS`].
     pub const OFFSET: u16 = 0x00;
     /// Value after reset.
-    pub const RESET: u32 = 0x5C01_0100;
+    pub const RESET: u32 = 0x5C01_0200;
     /// Offset, reset and access masks.
     pub const REGISTER: Register = Register {
         name: "VERSION",
@@ -59,13 +59,13 @@ pub mod version {
         max: 255,
     };
 
-    /// `[15:8]` ro, reset 1: Register-map major version (incompatible changes).
+    /// `[15:8]` ro, reset 2: Register-map major version (incompatible changes).
     pub const MAJOR: Field = Field {
         name: "VERSION.MAJOR",
         offset: OFFSET,
         bits: BitRange { lsb: 8, width: 8 },
         access: Access::Ro,
-        reset: 1,
+        reset: 2,
         min: 0,
         max: 255,
     };
@@ -102,7 +102,7 @@ pub mod control {
         pops_on_read: false,
     };
 
-    /// `[0:0]` rw, reset 0: 1: the pipeline runs. 0: PIXEL_IN ready is held low and no stage advances.
+    /// `[0:0]` rw, reset 0: 1: the pipeline takes pixels. 0: PIXEL_IN ready is held low (a frame already taken keeps flushing its last rows through the octaves).
     pub const ENABLE: Field = Field {
         name: "CONTROL.ENABLE",
         offset: OFFSET,
@@ -297,35 +297,35 @@ pub mod octaves {
     };
 }
 
-/// Low-contrast rejection of extrema. Offset 0x18, rw.
+/// Low-contrast rejection of extrema (Config::contrast_threshold of the model). Offset 0x18, rw.
 pub mod contrast_threshold {
     use crate::{Access, BitRange, Field, Register};
 
     /// Byte offset from [`super::BASE_ADDRESS`].
     pub const OFFSET: u16 = 0x18;
     /// Value after reset.
-    pub const RESET: u32 = 0x0000_0008;
+    pub const RESET: u32 = 0x0000_0800;
     /// Offset, reset and access masks.
     pub const REGISTER: Register = Register {
         name: "CONTRAST_THRESHOLD",
         offset: OFFSET,
         reset: RESET,
         ro_mask: 0x0000_0000,
-        rw_mask: 0x0000_00FF,
+        rw_mask: 0x0000_FFFF,
         w1c_mask: 0x0000_0000,
         wo_mask: 0x0000_0000,
         pops_on_read: false,
     };
 
-    /// `[7:0]` rw, reset 8: An extremum is kept only if |DoG| >= VALUE. DoG units are grey levels of the 8-bit smoothed images (a DoG sample is the difference of two of them, -255..255); 8 is about Lowe's 0.03 of full scale.
+    /// `[15:0]` rw, reset 2048: Q8.8 grey levels (256 = 1.0 grey level): an extremum is kept only if its DoG sample is a strict maximum above VALUE or a strict minimum below -VALUE. DoG samples are differences of two Q8.8 smoothed images. The reset 0x0800 (8.0 grey levels, about Lowe's 0.03 of full scale) is v1's reset of 8 whole grey levels; the model's Config::new and the host's session use 0x0100 (1.0).
     pub const VALUE: Field = Field {
         name: "CONTRAST_THRESHOLD.VALUE",
         offset: OFFSET,
-        bits: BitRange { lsb: 0, width: 8 },
+        bits: BitRange { lsb: 0, width: 16 },
         access: Access::Rw,
-        reset: 8,
+        reset: 2048,
         min: 0,
-        max: 255,
+        max: 65535,
     };
 }
 
@@ -361,7 +361,7 @@ pub mod edge_threshold {
     };
 }
 
-/// What the Sobel unit streams and from which scale. Offset 0x20, rw.
+/// Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream. Offset 0x20, rw.
 pub mod output_mode {
     use crate::{Access, BitRange, Field, Register};
 
@@ -381,7 +381,7 @@ pub mod output_mode {
         pops_on_read: false,
     };
 
-    /// `[0:0]` rw, reset 1: Which Sobel entries reach SOBEL_OUT.
+    /// `[0:0]` rw, reset 1: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
     pub const SOBEL_OUTPUT: Field = Field {
         name: "OUTPUT_MODE.SOBEL_OUTPUT",
         offset: OFFSET,
@@ -396,9 +396,9 @@ pub mod output_mode {
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
     #[repr(u32)]
     pub enum SobelOutput {
-        /// Every pixel of the selected scale of octave 0 (full resolution), in raster order (FIRST marks each line start).
+        /// The driver sends every row of every octave (SobelRows packets).
         Rows = 0,
-        /// Only the 16x16 patch around each point, taken from the selected scale of the point's own octave, in the order the points leave POINT_OUT, 256 entries each in raster order (FIRST marks each patch start).
+        /// The driver cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the fabric still streams every pixel.
         Patches = 1,
     }
 
@@ -421,7 +421,7 @@ pub mod output_mode {
     /// [`SOBEL_OUTPUT`] after reset.
     pub const SOBEL_OUTPUT_RESET: SobelOutput = SobelOutput::Patches;
 
-    /// `[5:4]` rw, reset 1, valid 0..=3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit.
+    /// `[5:4]` rw, reset 1, valid 0..=3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit in every octave (Config::sobel_scale).
     pub const SOBEL_SCALE: Field = Field {
         name: "OUTPUT_MODE.SOBEL_SCALE",
         offset: OFFSET,
@@ -485,7 +485,7 @@ pub mod sobel_fifo_level {
         pops_on_read: false,
     };
 
-    /// `[15:0]` ro, reset 0, valid 0..=4096: Entries waiting in the Sobel FIFO.
+    /// `[15:0]` ro, reset 0, valid 0..=3840: Entries waiting in the Sobel FIFO.
     pub const LEVEL: Field = Field {
         name: "SOBEL_FIFO_LEVEL.LEVEL",
         offset: OFFSET,
@@ -493,7 +493,7 @@ pub mod sobel_fifo_level {
         access: Access::Ro,
         reset: 0,
         min: 0,
-        max: 4096,
+        max: 3840,
     };
 }
 
@@ -613,7 +613,7 @@ pub mod latency_clocks {
         pops_on_read: false,
     };
 
-    /// `[31:0]` ro, reset 0: Clocks from the first pixel accepted on PIXEL_IN to the first pixel of the last octave's first scale; 0 until a frame has reached the last octave.
+    /// `[31:0]` ro, reset 0: Clocks from the first pixel accepted on PIXEL_IN to the first input sample of the last configured octave (OCTAVES.COUNT - 1; 0 clocks with one octave); 0 until a frame has reached the last octave.
     pub const CLOCKS: Field = Field {
         name: "LATENCY_CLOCKS.CLOCKS",
         offset: OFFSET,
@@ -625,7 +625,7 @@ pub mod latency_clocks {
     };
 }
 
-/// Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID. Offset 0x3C, ro.
+/// Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. Offset 0x3C, ro.
 pub mod point_fifo_data {
     use crate::{Access, BitRange, Field, Register};
 
@@ -638,14 +638,14 @@ pub mod point_fifo_data {
         name: "POINT_FIFO_DATA",
         offset: OFFSET,
         reset: RESET,
-        ro_mask: 0x87FF_FFFF,
+        ro_mask: 0x83FF_FFFF,
         rw_mask: 0x0000_0000,
         w1c_mask: 0x0000_0000,
         wo_mask: 0x0000_0000,
         pops_on_read: true,
     };
 
-    /// `[10:0]` ro, reset 0: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
+    /// `[10:0]` ro, reset 0: Column in the point's own octave (full-resolution column = X << OCTAVE).
     pub const X: Field = Field {
         name: "POINT_FIFO_DATA.X",
         offset: OFFSET,
@@ -678,7 +678,7 @@ pub mod point_fifo_data {
         max: 3,
     };
 
-    /// `[25:24]` ro, reset 0: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
+    /// `[25:24]` ro, reset 0: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1.
     pub const SCALE: Field = Field {
         name: "POINT_FIFO_DATA.SCALE",
         offset: OFFSET,
@@ -689,18 +689,7 @@ pub mod point_fifo_data {
         max: 3,
     };
 
-    /// `[26:26]` ro, reset 0: 1: a maximum of the DoG, 0: a minimum.
-    pub const POLARITY: Field = Field {
-        name: "POINT_FIFO_DATA.POLARITY",
-        offset: OFFSET,
-        bits: BitRange { lsb: 26, width: 1 },
-        access: Access::Ro,
-        reset: 0,
-        min: 0,
-        max: 1,
-    };
-
-    /// `[31:31]` ro, reset 0: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed.
+    /// `[31:31]` ro, reset 0: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed and the holding registers read 0.
     pub const VALID: Field = Field {
         name: "POINT_FIFO_DATA.VALID",
         offset: OFFSET,
@@ -712,8 +701,8 @@ pub mod point_fifo_data {
     };
 }
 
-/// Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID. Offset 0x40, ro.
-pub mod sobel_fifo_data {
+/// Word 1 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect). Offset 0x40, ro.
+pub mod point_fifo_dxdy {
     use crate::{Access, BitRange, Field, Register};
 
     /// Byte offset from [`super::BASE_ADDRESS`].
@@ -722,17 +711,103 @@ pub mod sobel_fifo_data {
     pub const RESET: u32 = 0x0000_0000;
     /// Offset, reset and access masks.
     pub const REGISTER: Register = Register {
+        name: "POINT_FIFO_DXDY",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0xFFFF_FFFF,
+        rw_mask: 0x0000_0000,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[15:0]` ro, reset 0: Sub-pixel column offset, Q2.13 two's complement (8192 = 1 pixel of the point's octave), |DX| <= MAX_OFFSET.
+    pub const DX: Field = Field {
+        name: "POINT_FIFO_DXDY.DX",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 16 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 65535,
+    };
+
+    /// `[31:16]` ro, reset 0: Sub-pixel row offset, Q2.13 two's complement, |DY| <= MAX_OFFSET.
+    pub const DY: Field = Field {
+        name: "POINT_FIFO_DXDY.DY",
+        offset: OFFSET,
+        bits: BitRange { lsb: 16, width: 16 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 65535,
+    };
+}
+
+/// Word 2 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect). Offset 0x44, ro.
+pub mod point_fifo_dsdog {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x44;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "POINT_FIFO_DSDOG",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0xFFFF_FFFF,
+        rw_mask: 0x0000_0000,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[15:0]` ro, reset 0: Sub-scale offset in DoG-level units, Q2.13 two's complement, |DS| <= MAX_OFFSET.
+    pub const DS: Field = Field {
+        name: "POINT_FIFO_DSDOG.DS",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 16 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 65535,
+    };
+
+    /// `[31:16]` ro, reset 0: DoG sample at the extremum, Q8.8 grey levels two's complement (i16): positive for a maximum, negative for a minimum.
+    pub const DOG: Field = Field {
+        name: "POINT_FIFO_DSDOG.DOG",
+        offset: OFFSET,
+        bits: BitRange { lsb: 16, width: 16 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 65535,
+    };
+}
+
+/// Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. Offset 0x48, ro.
+pub mod sobel_fifo_data {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x48;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
         name: "SOBEL_FIFO_DATA",
         offset: OFFSET,
         reset: RESET,
-        ro_mask: 0x8000_7FFF,
+        ro_mask: 0x8000_FFFF,
         rw_mask: 0x0000_0000,
         w1c_mask: 0x0000_0000,
         wo_mask: 0x0000_0000,
         pops_on_read: true,
     };
 
-    /// `[7:0]` ro, reset 0: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
+    /// `[7:0]` ro, reset 0: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs).
     pub const MAGNITUDE: Field = Field {
         name: "SOBEL_FIFO_DATA.MAGNITUDE",
         offset: OFFSET,
@@ -743,7 +818,7 @@ pub mod sobel_fifo_data {
         max: 255,
     };
 
-    /// `[13:8]` ro, reset 0: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
+    /// `[13:8]` ro, reset 0: Gradient direction in 1/64 turns (5.625 degrees): 0 along +x, increasing toward +y (image y points down).
     pub const ORIENTATION: Field = Field {
         name: "SOBEL_FIFO_DATA.ORIENTATION",
         offset: OFFSET,
@@ -754,18 +829,18 @@ pub mod sobel_fifo_data {
         max: 63,
     };
 
-    /// `[14:14]` ro, reset 0: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
-    pub const FIRST: Field = Field {
-        name: "SOBEL_FIFO_DATA.FIRST",
+    /// `[15:14]` ro, reset 0: Octave of the pixel, 0 = full resolution.
+    pub const OCTAVE: Field = Field {
+        name: "SOBEL_FIFO_DATA.OCTAVE",
         offset: OFFSET,
-        bits: BitRange { lsb: 14, width: 1 },
+        bits: BitRange { lsb: 14, width: 2 },
         access: Access::Ro,
         reset: 0,
         min: 0,
-        max: 1,
+        max: 3,
     };
 
-    /// `[31:31]` ro, reset 0: 1: the other fields hold a Sobel entry (and the read removed it). 0: the FIFO was empty; nothing was removed.
+    /// `[31:31]` ro, reset 0: 1: the other fields hold a Sobel pixel (and the read removed it). 0: the FIFO was empty; nothing was removed and SOBEL_FIFO_POSITION reads 0.
     pub const VALID: Field = Field {
         name: "SOBEL_FIFO_DATA.VALID",
         offset: OFFSET,
@@ -777,8 +852,83 @@ pub mod sobel_fifo_data {
     };
 }
 
+/// Word 1 of the Sobel pixel last popped from SOBEL_FIFO_DATA (a holding register: reading it has no side effect). Offset 0x4C, ro.
+pub mod sobel_fifo_position {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x4C;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "SOBEL_FIFO_POSITION",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0xFFFF_FFFF,
+        rw_mask: 0x0000_0000,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[15:0]` ro, reset 0: Column in the pixel's own octave.
+    pub const X: Field = Field {
+        name: "SOBEL_FIFO_POSITION.X",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 16 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 65535,
+    };
+
+    /// `[31:16]` ro, reset 0: Row in the pixel's own octave.
+    pub const Y: Field = Field {
+        name: "SOBEL_FIFO_POSITION.Y",
+        offset: OFFSET,
+        bits: BitRange { lsb: 16, width: 16 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 65535,
+    };
+}
+
+/// Bound of the sub-pixel refinement (Config::max_offset of the model). Offset 0x50, rw.
+pub mod max_offset {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x50;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_1000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "MAX_OFFSET",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0x0000_0000,
+        rw_mask: 0x0000_FFFF,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[15:0]` rw, reset 0x1000, valid 0..=8191: Largest accepted |offset| per axis (x, y, scale), raw Q2.13: a refined extremum with any larger offset is dropped. 4096 = 0.5 sample; must stay below 8192 (1.0).
+    pub const VALUE: Field = Field {
+        name: "MAX_OFFSET.VALUE",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 16 },
+        access: Access::Rw,
+        reset: 4096,
+        min: 0,
+        max: 8191,
+    };
+}
+
 /// Every register, sorted by offset.
-pub static REGISTERS: [Register; 17] = [
+pub static REGISTERS: [Register; 21] = [
     version::REGISTER,
     control::REGISTER,
     status::REGISTER,
@@ -795,7 +945,11 @@ pub static REGISTERS: [Register; 17] = [
     frame_count::REGISTER,
     latency_clocks::REGISTER,
     point_fifo_data::REGISTER,
+    point_fifo_dxdy::REGISTER,
+    point_fifo_dsdog::REGISTER,
     sobel_fifo_data::REGISTER,
+    sobel_fifo_position::REGISTER,
+    max_offset::REGISTER,
 ];
 
 /// Stream ports: signal widths and the bit layout of each DATA word.
@@ -810,47 +964,7 @@ pub mod ports {
         pub const READY_WIDTH: u32 = 1;
         /// Width of `SOF` (in): Start of frame: this pixel is (0, 0).
         pub const SOF_WIDTH: u32 = 1;
-        /// Width of `EOL` (in): End of line: this pixel is the last of its line.
+        /// Width of `EOL` (in): End of line: this pixel is the last of its line. The fabric counts lines by WIDTH and does not check EOL.
         pub const EOL_WIDTH: u32 = 1;
-    }
-
-    /// Detected scale-space extrema, into the point FIFO. Direction: out of the fabric.
-    pub mod point_out {
-        use crate::BitRange;
-
-        /// Width of `DATA` (out): One point, laid out as below.
-        pub const DATA_WIDTH: u32 = 27;
-        /// Width of `VALID` (out): DATA holds a point.
-        pub const VALID_WIDTH: u32 = 1;
-        /// Width of `READY` (in): The FIFO has room; when 0 the point is dropped and counted.
-        pub const READY_WIDTH: u32 = 1;
-        /// `DATA[10:0]`: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
-        pub const X: BitRange = BitRange { lsb: 0, width: 11 };
-        /// `DATA[21:11]`: Row in the point's own octave.
-        pub const Y: BitRange = BitRange { lsb: 11, width: 11 };
-        /// `DATA[23:22]`: Octave index, 0 = full resolution.
-        pub const OCTAVE: BitRange = BitRange { lsb: 22, width: 2 };
-        /// `DATA[25:24]`: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
-        pub const SCALE: BitRange = BitRange { lsb: 24, width: 2 };
-        /// `DATA[26:26]`: 1: a maximum of the DoG, 0: a minimum.
-        pub const POLARITY: BitRange = BitRange { lsb: 26, width: 1 };
-    }
-
-    /// Gradient magnitude and orientation from the Sobel/CORDIC unit, into the Sobel FIFO. Direction: out of the fabric.
-    pub mod sobel_out {
-        use crate::BitRange;
-
-        /// Width of `DATA` (out): One gradient sample, laid out as below.
-        pub const DATA_WIDTH: u32 = 15;
-        /// Width of `VALID` (out): DATA holds a sample.
-        pub const VALID_WIDTH: u32 = 1;
-        /// Width of `READY` (in): The FIFO has room; when 0 the sample is dropped and counted.
-        pub const READY_WIDTH: u32 = 1;
-        /// `DATA[7:0]`: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
-        pub const MAGNITUDE: BitRange = BitRange { lsb: 0, width: 8 };
-        /// `DATA[13:8]`: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
-        pub const ORIENTATION: BitRange = BitRange { lsb: 8, width: 6 };
-        /// `DATA[14:14]`: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
-        pub const FIRST: BitRange = BitRange { lsb: 14, width: 1 };
     }
 }

@@ -33,7 +33,7 @@ pub trait Registers: RegisterBus {
         self.read_field(&regs::version::MINOR) as u8
     }
 
-    /// VERSION.MAJOR `[15:8]` ro, reset 1: Register-map major version (incompatible changes).
+    /// VERSION.MAJOR `[15:8]` ro, reset 2: Register-map major version (incompatible changes).
     fn version_major(&mut self) -> u8 {
         self.read_field(&regs::version::MAJOR) as u8
     }
@@ -45,7 +45,7 @@ pub trait Registers: RegisterBus {
 
     // CONTROL (offset 0x04): Run control. Configuration registers are sampled at each start of frame.
 
-    /// CONTROL.ENABLE `[0:0]` rw, reset 0: 1: the pipeline runs. 0: PIXEL_IN ready is held low and no stage advances.
+    /// CONTROL.ENABLE `[0:0]` rw, reset 0: 1: the pipeline takes pixels. 0: PIXEL_IN ready is held low (a frame already taken keeps flushing its last rows through the octaves).
     fn control_enable(&mut self) -> bool {
         self.read_field(&regs::control::ENABLE) != 0
     }
@@ -138,15 +138,15 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::octaves::COUNT, u32::from(value))
     }
 
-    // CONTRAST_THRESHOLD (offset 0x18): Low-contrast rejection of extrema.
+    // CONTRAST_THRESHOLD (offset 0x18): Low-contrast rejection of extrema (Config::contrast_threshold of the model).
 
-    /// CONTRAST_THRESHOLD.VALUE `[7:0]` rw, reset 8: An extremum is kept only if |DoG| >= VALUE. DoG units are grey levels of the 8-bit smoothed images (a DoG sample is the difference of two of them, -255..255); 8 is about Lowe's 0.03 of full scale.
-    fn contrast_threshold_value(&mut self) -> u8 {
-        self.read_field(&regs::contrast_threshold::VALUE) as u8
+    /// CONTRAST_THRESHOLD.VALUE `[15:0]` rw, reset 2048: Q8.8 grey levels (256 = 1.0 grey level): an extremum is kept only if its DoG sample is a strict maximum above VALUE or a strict minimum below -VALUE. DoG samples are differences of two Q8.8 smoothed images. The reset 0x0800 (8.0 grey levels, about Lowe's 0.03 of full scale) is v1's reset of 8 whole grey levels; the model's Config::new and the host's session use 0x0100 (1.0).
+    fn contrast_threshold_value(&mut self) -> u16 {
+        self.read_field(&regs::contrast_threshold::VALUE) as u16
     }
 
-    /// Writes CONTRAST_THRESHOLD.VALUE (`[7:0]` rw, reset 8); see [`Self::contrast_threshold_value`].
-    fn set_contrast_threshold_value(&mut self, value: u8) -> Result<(), Error> {
+    /// Writes CONTRAST_THRESHOLD.VALUE (`[15:0]` rw, reset 2048); see [`Self::contrast_threshold_value`].
+    fn set_contrast_threshold_value(&mut self, value: u16) -> Result<(), Error> {
         self.write_field(&regs::contrast_threshold::VALUE, u32::from(value))
     }
 
@@ -162,9 +162,9 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::edge_threshold::R, u32::from(value))
     }
 
-    // OUTPUT_MODE (offset 0x20): What the Sobel unit streams and from which scale.
+    // OUTPUT_MODE (offset 0x20): Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream.
 
-    /// OUTPUT_MODE.SOBEL_OUTPUT `[0:0]` rw, reset 1: Which Sobel entries reach SOBEL_OUT.
+    /// OUTPUT_MODE.SOBEL_OUTPUT `[0:0]` rw, reset 1: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
     fn output_mode_sobel_output(&mut self) -> regs::output_mode::SobelOutput {
         match self.read_field(&regs::output_mode::SOBEL_OUTPUT) {
             0 => regs::output_mode::SobelOutput::Rows,
@@ -177,7 +177,7 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::output_mode::SOBEL_OUTPUT, value.bits())
     }
 
-    /// OUTPUT_MODE.SOBEL_SCALE `[5:4]` rw, reset 1, valid 0..=3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit.
+    /// OUTPUT_MODE.SOBEL_SCALE `[5:4]` rw, reset 1, valid 0..=3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit in every octave (Config::sobel_scale).
     fn output_mode_sobel_scale(&mut self) -> u8 {
         self.read_field(&regs::output_mode::SOBEL_SCALE) as u8
     }
@@ -196,7 +196,7 @@ pub trait Registers: RegisterBus {
 
     // SOBEL_FIFO_LEVEL (offset 0x28): Fill level of the Sobel FIFO.
 
-    /// SOBEL_FIFO_LEVEL.LEVEL `[15:0]` ro, reset 0, valid 0..=4096: Entries waiting in the Sobel FIFO.
+    /// SOBEL_FIFO_LEVEL.LEVEL `[15:0]` ro, reset 0, valid 0..=3840: Entries waiting in the Sobel FIFO.
     fn sobel_fifo_level_level(&mut self) -> u16 {
         self.read_field(&regs::sobel_fifo_level::LEVEL) as u16
     }
@@ -224,34 +224,82 @@ pub trait Registers: RegisterBus {
 
     // LATENCY_CLOCKS (offset 0x38): Pipeline latency measured on the last frame.
 
-    /// LATENCY_CLOCKS.CLOCKS `[31:0]` ro, reset 0: Clocks from the first pixel accepted on PIXEL_IN to the first pixel of the last octave's first scale; 0 until a frame has reached the last octave.
+    /// LATENCY_CLOCKS.CLOCKS `[31:0]` ro, reset 0: Clocks from the first pixel accepted on PIXEL_IN to the first input sample of the last configured octave (OCTAVES.COUNT - 1; 0 clocks with one octave); 0 until a frame has reached the last octave.
     fn latency_clocks_clocks(&mut self) -> u32 {
         self.read_field(&regs::latency_clocks::CLOCKS)
     }
 
-    // POINT_FIFO_DATA (offset 0x3C): Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID.
+    // POINT_FIFO_DATA (offset 0x3C): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop.
 
     /// Reads POINT_FIFO_DATA once (the read pops the FIFO's head) and returns the whole word.
     fn pop_point_fifo_data(&mut self) -> PointFifoData {
         PointFifoData(self.read(regs::point_fifo_data::OFFSET))
     }
 
-    // SOBEL_FIFO_DATA (offset 0x40): Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID.
+    // POINT_FIFO_DXDY (offset 0x40): Word 1 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect).
+
+    /// POINT_FIFO_DXDY.DX `[15:0]` ro, reset 0: Sub-pixel column offset, Q2.13 two's complement (8192 = 1 pixel of the point's octave), |DX| <= MAX_OFFSET.
+    fn point_fifo_dxdy_dx(&mut self) -> u16 {
+        self.read_field(&regs::point_fifo_dxdy::DX) as u16
+    }
+
+    /// POINT_FIFO_DXDY.DY `[31:16]` ro, reset 0: Sub-pixel row offset, Q2.13 two's complement, |DY| <= MAX_OFFSET.
+    fn point_fifo_dxdy_dy(&mut self) -> u16 {
+        self.read_field(&regs::point_fifo_dxdy::DY) as u16
+    }
+
+    // POINT_FIFO_DSDOG (offset 0x44): Word 2 of the point last popped from POINT_FIFO_DATA (a holding register: reading it has no side effect).
+
+    /// POINT_FIFO_DSDOG.DS `[15:0]` ro, reset 0: Sub-scale offset in DoG-level units, Q2.13 two's complement, |DS| <= MAX_OFFSET.
+    fn point_fifo_dsdog_ds(&mut self) -> u16 {
+        self.read_field(&regs::point_fifo_dsdog::DS) as u16
+    }
+
+    /// POINT_FIFO_DSDOG.DOG `[31:16]` ro, reset 0: DoG sample at the extremum, Q8.8 grey levels two's complement (i16): positive for a maximum, negative for a minimum.
+    fn point_fifo_dsdog_dog(&mut self) -> u16 {
+        self.read_field(&regs::point_fifo_dsdog::DOG) as u16
+    }
+
+    // SOBEL_FIFO_DATA (offset 0x48): Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
 
     /// Reads SOBEL_FIFO_DATA once (the read pops the FIFO's head) and returns the whole word.
     fn pop_sobel_fifo_data(&mut self) -> SobelFifoData {
         SobelFifoData(self.read(regs::sobel_fifo_data::OFFSET))
     }
+
+    // SOBEL_FIFO_POSITION (offset 0x4C): Word 1 of the Sobel pixel last popped from SOBEL_FIFO_DATA (a holding register: reading it has no side effect).
+
+    /// SOBEL_FIFO_POSITION.X `[15:0]` ro, reset 0: Column in the pixel's own octave.
+    fn sobel_fifo_position_x(&mut self) -> u16 {
+        self.read_field(&regs::sobel_fifo_position::X) as u16
+    }
+
+    /// SOBEL_FIFO_POSITION.Y `[31:16]` ro, reset 0: Row in the pixel's own octave.
+    fn sobel_fifo_position_y(&mut self) -> u16 {
+        self.read_field(&regs::sobel_fifo_position::Y) as u16
+    }
+
+    // MAX_OFFSET (offset 0x50): Bound of the sub-pixel refinement (Config::max_offset of the model).
+
+    /// MAX_OFFSET.VALUE `[15:0]` rw, reset 0x1000, valid 0..=8191: Largest accepted |offset| per axis (x, y, scale), raw Q2.13: a refined extremum with any larger offset is dropped. 4096 = 0.5 sample; must stay below 8192 (1.0).
+    fn max_offset_value(&mut self) -> u16 {
+        self.read_field(&regs::max_offset::VALUE) as u16
+    }
+
+    /// Writes MAX_OFFSET.VALUE (`[15:0]` rw, reset 0x1000, valid 0..=8191); see [`Self::max_offset_value`].
+    fn set_max_offset_value(&mut self, value: u16) -> Result<(), Error> {
+        self.write_field(&regs::max_offset::VALUE, u32::from(value))
+    }
 }
 
 impl<B: RegisterBus + ?Sized> Registers for B {}
 
-/// A value of POINT_FIFO_DATA, as [`Registers::pop_point_fifo_data`] read it: Head of the point FIFO, laid out as POINT_OUT's DATA plus VALID.
+/// A value of POINT_FIFO_DATA, as [`Registers::pop_point_fifo_data`] read it: Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PointFifoData(pub u32);
 
 impl PointFifoData {
-    /// X `[10:0]` ro, reset 0: Column in the point's own octave (full-resolution column = X << (OCTAVE)).
+    /// X `[10:0]` ro, reset 0: Column in the point's own octave (full-resolution column = X << OCTAVE).
     pub const fn x(self) -> u16 {
         regs::point_fifo_data::X.extract(self.0) as u16
     }
@@ -266,43 +314,38 @@ impl PointFifoData {
         regs::point_fifo_data::OCTAVE.extract(self.0) as u8
     }
 
-    /// SCALE `[25:24]` ro, reset 0: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1; 2 bits leave room for deeper octaves.
+    /// SCALE `[25:24]` ro, reset 0: DoG level of the extremum inside its octave. With 3 DoG levels per octave only level 1 has a level above and below, so this fabric always reports 1.
     pub const fn scale(self) -> u8 {
         regs::point_fifo_data::SCALE.extract(self.0) as u8
     }
 
-    /// POLARITY `[26:26]` ro, reset 0: 1: a maximum of the DoG, 0: a minimum.
-    pub const fn polarity(self) -> bool {
-        regs::point_fifo_data::POLARITY.extract(self.0) != 0
-    }
-
-    /// VALID `[31:31]` ro, reset 0: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed.
+    /// VALID `[31:31]` ro, reset 0: 1: the other fields hold a point (and the read removed it). 0: the FIFO was empty; nothing was removed and the holding registers read 0.
     pub const fn valid(self) -> bool {
         regs::point_fifo_data::VALID.extract(self.0) != 0
     }
 }
 
-/// A value of SOBEL_FIFO_DATA, as [`Registers::pop_sobel_fifo_data`] read it: Head of the Sobel FIFO, laid out as SOBEL_OUT's DATA plus VALID.
+/// A value of SOBEL_FIFO_DATA, as [`Registers::pop_sobel_fifo_data`] read it: Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SobelFifoData(pub u32);
 
 impl SobelFifoData {
-    /// MAGNITUDE `[7:0]` ro, reset 0: Gradient magnitude: CORDIC x after 4 steps times 5/8, saturated to 8 bits.
+    /// MAGNITUDE `[7:0]` ro, reset 0: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs).
     pub const fn magnitude(self) -> u8 {
         regs::sobel_fifo_data::MAGNITUDE.extract(self.0) as u8
     }
 
-    /// ORIENTATION `[13:8]` ro, reset 0: Gradient direction in 1/64 turns: 0 along +x, increasing toward +y (image y points down).
+    /// ORIENTATION `[13:8]` ro, reset 0: Gradient direction in 1/64 turns (5.625 degrees): 0 along +x, increasing toward +y (image y points down).
     pub const fn orientation(self) -> u8 {
         regs::sobel_fifo_data::ORIENTATION.extract(self.0) as u8
     }
 
-    /// FIRST `[14:14]` ro, reset 0: First sample of a line (OUTPUT_MODE.SOBEL_OUTPUT = ROWS) or of a patch (PATCHES).
-    pub const fn first(self) -> bool {
-        regs::sobel_fifo_data::FIRST.extract(self.0) != 0
+    /// OCTAVE `[15:14]` ro, reset 0: Octave of the pixel, 0 = full resolution.
+    pub const fn octave(self) -> u8 {
+        regs::sobel_fifo_data::OCTAVE.extract(self.0) as u8
     }
 
-    /// VALID `[31:31]` ro, reset 0: 1: the other fields hold a Sobel entry (and the read removed it). 0: the FIFO was empty; nothing was removed.
+    /// VALID `[31:31]` ro, reset 0: 1: the other fields hold a Sobel pixel (and the read removed it). 0: the FIFO was empty; nothing was removed and SOBEL_FIFO_POSITION reads 0.
     pub const fn valid(self) -> bool {
         regs::sobel_fifo_data::VALID.extract(self.0) != 0
     }

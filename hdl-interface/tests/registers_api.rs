@@ -2,7 +2,10 @@
 //! MMIO over a word array, and through `&mut B` as a generic driver receives it.
 
 use stereocal_hdl::regs::output_mode::SobelOutput;
-use stereocal_hdl::regs::{self, control, output_mode, point_fifo_data, sobel_fifo_data, status};
+use stereocal_hdl::regs::{
+    self, control, output_mode, point_fifo_data, point_fifo_dsdog, point_fifo_dxdy,
+    sobel_fifo_data, sobel_fifo_position, status,
+};
 use stereocal_hdl::regs_api::{PointFifoData, SobelFifoData};
 use stereocal_hdl::{Error, Mmio, RegisterBank, RegisterBus, Registers};
 
@@ -17,7 +20,8 @@ fn getters_read_the_reset_state() {
     assert_eq!(bank.width_value(), 640);
     assert_eq!(bank.height_value(), 480);
     assert_eq!(bank.octaves_count(), 4);
-    assert_eq!(bank.contrast_threshold_value(), 8);
+    assert_eq!(bank.contrast_threshold_value(), 8 << 8);
+    assert_eq!(bank.max_offset_value(), 4096);
     assert_eq!(bank.edge_threshold_r(), 10);
     assert_eq!(
         bank.output_mode_sobel_output(),
@@ -93,27 +97,37 @@ fn firing_a_strobe_keeps_enable_and_fires_nothing_else() {
     assert!(bank.control_enable());
 }
 
-/// A bus whose FIFO data registers pop a queue, counting the reads.
+/// A bus whose FIFO data registers pop a queue, counting the reads; a pop loads the entry's
+/// other words into holding registers (zero when the FIFO was empty), as the fabric does.
 struct Fifos {
-    points: [u32; 2],
-    sobel: [u32; 1],
+    /// Point entries: word 0, DXDY, DSDOG.
+    points: [[u32; 3]; 2],
+    /// Sobel entries: word 0, position.
+    sobel: [[u32; 2]; 1],
     point_reads: usize,
     sobel_reads: usize,
+    point_hold: [u32; 2],
+    sobel_hold: u32,
 }
 
 impl RegisterBus for Fifos {
     fn read(&mut self, offset: u16) -> u32 {
         match offset {
             point_fifo_data::OFFSET => {
-                let word = self.points.get(self.point_reads).copied().unwrap_or(0);
+                let entry = self.points.get(self.point_reads).copied().unwrap_or([0; 3]);
                 self.point_reads += 1;
-                word
+                self.point_hold = [entry[1], entry[2]];
+                entry[0]
             }
+            point_fifo_dxdy::OFFSET => self.point_hold[0],
+            point_fifo_dsdog::OFFSET => self.point_hold[1],
             sobel_fifo_data::OFFSET => {
-                let word = self.sobel.get(self.sobel_reads).copied().unwrap_or(0);
+                let entry = self.sobel.get(self.sobel_reads).copied().unwrap_or([0; 2]);
                 self.sobel_reads += 1;
-                word
+                self.sobel_hold = entry[1];
+                entry[0]
             }
+            sobel_fifo_position::OFFSET => self.sobel_hold,
             _ => 0,
         }
     }
@@ -123,28 +137,57 @@ impl RegisterBus for Fifos {
 
 #[test]
 fn popping_reads_the_fifo_once_and_types_every_field() {
-    let point = (1 << 31) | (1 << 26) | (1 << 24) | (3 << 22) | (59 << 11) | 79;
-    let sobel = (1 << 31) | (1 << 14) | (63 << 8) | 200;
+    let point = (1 << 31) | (1 << 24) | (3 << 22) | (1023 << 11) | 1279;
+    // dx = -0.5, dy = 0.25, ds = -1/8192, dog = -3.5 grey levels.
+    let dxdy = (0x0800 << 16) | 0xF000;
+    let dsdog = (0xFC80 << 16) | 0xFFFF;
+    let sobel = (1 << 31) | (2 << 14) | (63 << 8) | 200;
+    let position = (239 << 16) | 319;
     let mut bus = Fifos {
-        points: [point, 0],
-        sobel: [sobel],
+        points: [[point, dxdy, dsdog], [0; 3]],
+        sobel: [[sobel, position]],
         point_reads: 0,
         sobel_reads: 0,
+        point_hold: [0; 2],
+        sobel_hold: 0,
     };
     let p = bus.pop_point_fifo_data();
     assert_eq!(bus.point_reads, 1);
     assert_eq!(p, PointFifoData(point));
-    assert!(p.valid() && p.polarity());
-    assert_eq!((p.x(), p.y(), p.octave(), p.scale()), (79, 59, 3, 1));
+    assert!(p.valid());
+    assert_eq!((p.x(), p.y(), p.octave(), p.scale()), (1279, 1023, 3, 1));
+    assert_eq!(
+        (
+            bus.point_fifo_dxdy_dx() as i16,
+            bus.point_fifo_dxdy_dy() as i16
+        ),
+        (-4096, 2048)
+    );
+    assert_eq!(
+        (
+            bus.point_fifo_dsdog_ds() as i16,
+            bus.point_fifo_dsdog_dog() as i16
+        ),
+        (-1, -896)
+    );
+    assert_eq!(bus.point_reads, 1, "holding registers do not pop");
     let empty = bus.pop_point_fifo_data();
     assert!(!empty.valid());
     assert_eq!(bus.point_reads, 2);
+    assert_eq!(
+        (bus.point_fifo_dxdy_dx(), bus.point_fifo_dsdog_dog()),
+        (0, 0)
+    );
 
     let s = bus.pop_sobel_fifo_data();
     assert_eq!(bus.sobel_reads, 1);
     assert_eq!(s, SobelFifoData(sobel));
-    assert!(s.valid() && s.first());
-    assert_eq!((s.magnitude(), s.orientation()), (200, 63));
+    assert!(s.valid());
+    assert_eq!((s.magnitude(), s.orientation(), s.octave()), (200, 63, 2));
+    assert_eq!(
+        (bus.sobel_fifo_position_x(), bus.sobel_fifo_position_y()),
+        (319, 239)
+    );
 }
 
 #[test]
@@ -167,10 +210,10 @@ fn mmio_gets_the_same_interface() {
 fn generic_code_reaches_it_through_mut_references() {
     fn configure<B: RegisterBus>(mut bus: B) -> Result<(), Error> {
         bus.set_height_value(240)?;
-        bus.set_contrast_threshold_value(12)
+        bus.set_contrast_threshold_value(12 << 8)
     }
     let mut bank = RegisterBank::new();
     configure(&mut bank).unwrap();
     assert_eq!(bank.height_value(), 240);
-    assert_eq!(bank.contrast_threshold_value(), 12);
+    assert_eq!(bank.contrast_threshold_value(), 12 << 8);
 }

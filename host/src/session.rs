@@ -41,14 +41,15 @@ impl Default for SessionConfig {
 
 /// The fabric's configuration for `width` x `height` frames.
 ///
-/// The contrast threshold is 1 grey level rather than the register's reset value (8, Lowe's
-/// 0.03 of full scale): the verge estimate gains from every stable keypoint, and the ratio
-/// test and RANSAC reject the weak ones that do not match.
+/// The contrast threshold is 1 grey level (256 in the register's Q8.8) rather than the
+/// register's reset value (8 grey levels, Lowe's 0.03 of full scale): the verge estimate gains
+/// from every stable keypoint, and the ratio test and RANSAC reject the weak ones that do not
+/// match.
 pub fn fabric_config(width: u16, height: u16, sobel_output: SobelOutput) -> FabricConfig {
     FabricConfig {
         width,
         height,
-        contrast_threshold: 1,
+        contrast_threshold: 1 << 8,
         sobel_output,
         ..FabricConfig::default()
     }

@@ -54,10 +54,11 @@ fn config(mode: SobelOutput) -> FabricConfig {
         width: W,
         height: H,
         octaves: 3,
-        contrast_threshold: 1,
+        contrast_threshold: 1 << 8,
         edge_ratio: 10,
         sobel_output: mode,
         sobel_scale: 1,
+        max_offset: 4096,
     }
 }
 

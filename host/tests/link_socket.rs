@@ -37,10 +37,11 @@ fn session(link: impl Link) {
         width: 32,
         height: 16,
         octaves: 2,
-        contrast_threshold: 4,
+        contrast_threshold: 4 << 8,
         edge_ratio: 10,
         sobel_output: SobelOutput::Rows,
         sobel_scale: 1,
+        max_offset: 4096,
     };
     driver
         .configure(&config, T)
@@ -73,8 +74,8 @@ fn run<S: Read + Write + Send + 'static>(mut device_side: S, link: impl Link) {
     session(link);
     // The driver (and its end of the stream) is gone: the device sees the close.
     let received = device.join().expect("device thread");
-    // Hello, 6 writes, 6 reads, enable.
-    assert_eq!(received, 14);
+    // Hello, 7 writes, 7 reads (the configuration registers, MAX_OFFSET included), enable.
+    assert_eq!(received, 16);
 }
 
 #[test]

@@ -49,19 +49,17 @@ struct FrameState {
     patches_dropped: u32,
 }
 
-/// The fabric configuration the registers describe, in the model's terms.
-///
-/// The contrast register counts whole grey levels; the model compares Q8.8 DoG samples, so the
-/// value moves up 8 bits. The refinement bound is not a register: the model's default is kept.
+/// The fabric configuration the registers describe, in the model's terms: every register
+/// holds the model's value as is (CONTRAST_THRESHOLD in Q8.8, MAX_OFFSET in raw Q2.13).
 pub fn fabric_config(registers: &FabricConfig) -> Config {
     Config {
         width: registers.width,
         height: registers.height,
         octaves: registers.octaves,
-        contrast_threshold: u16::from(registers.contrast_threshold) << 8,
+        contrast_threshold: registers.contrast_threshold,
         edge_ratio: registers.edge_ratio,
         sobel_scale: registers.sobel_scale,
-        ..Config::new(registers.width, registers.height)
+        max_offset: registers.max_offset,
     }
 }
 

@@ -266,10 +266,11 @@ const SMALL: FabricConfig = FabricConfig {
     width: 48,
     height: 40,
     octaves: 2,
-    contrast_threshold: 8,
+    contrast_threshold: 8 << 8,
     edge_ratio: 10,
     sobel_output: SobelOutput::Patches,
     sobel_scale: 1,
+    max_offset: 4096,
 };
 
 /// The patch a point at (x, y) of `octave` must get: the scripted image, zero outside it and
@@ -866,10 +867,11 @@ const TEXTURED: FabricConfig = FabricConfig {
     width: 160,
     height: 120,
     octaves: 3,
-    contrast_threshold: 6,
+    contrast_threshold: 6 << 8,
     edge_ratio: 10,
     sobel_output: SobelOutput::Patches,
     sobel_scale: 1,
+    max_offset: 4096,
 };
 
 #[test]
@@ -1014,7 +1016,7 @@ fn register_level_model_sends_the_same_records_as_the_fast_path() {
         width: 64,
         height: 48,
         octaves: 2,
-        contrast_threshold: 4,
+        contrast_threshold: 4 << 8,
         ..TEXTURED
     };
     let image = blob_image(64, 48, 2);

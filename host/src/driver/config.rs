@@ -78,10 +78,11 @@ mod tests {
             width: 320,
             height: 240,
             octaves: 3,
-            contrast_threshold: 5,
+            contrast_threshold: 5 << 8,
             edge_ratio: 12,
             sobel_output: regs::output_mode::SobelOutput::Rows,
             sobel_scale: 2,
+            max_offset: 4096,
         };
         let plan = plan(&config).unwrap();
         let offsets: Vec<u16> = plan.read_back.iter().map(|&(a, _)| a).collect();
@@ -93,7 +94,8 @@ mod tests {
                 regs::octaves::OFFSET,
                 regs::contrast_threshold::OFFSET,
                 regs::edge_threshold::OFFSET,
-                regs::output_mode::OFFSET
+                regs::output_mode::OFFSET,
+                regs::max_offset::OFFSET
             ]
         );
         assert!(plan.read_back.contains(&(regs::width::OFFSET, 320)));
