@@ -513,6 +513,10 @@ fn check_generated_names(d: &Description) -> Result<(), RegenError> {
             }
         }
     }
+    // The ports and internal names of the Verilog register block.
+    for (name, origin) in crate::emit::verilog_regs::identifiers(d) {
+        claim("sc_regs:", name, origin)?;
+    }
     for p in &d.ports {
         let origin = format!("port {}", p.name);
         let module = format!("ports::{}::", p.name);
@@ -973,6 +977,17 @@ doc = "v"
                 .replace("name = \"VALUE\"", "name = \"FIELD\""),
         );
         assert!(e.contains("`read_field`"), "{e}");
+    }
+
+    #[test]
+    fn colliding_register_block_ports_are_rejected() {
+        // Register BUS field ADDR would be the Verilog port `bus_addr` of sc_regs.
+        let e = error_of(
+            &MINIMAL
+                .replace("name = \"WIDTH\"", "name = \"BUS\"")
+                .replace("name = \"VALUE\"", "name = \"ADDR\""),
+        );
+        assert!(e.contains("`bus_addr`"), "{e}");
     }
 
     #[test]

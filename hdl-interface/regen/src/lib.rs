@@ -2,9 +2,10 @@
 //!
 //! `hdl-interface/regmap.toml` is the one description of the fabric's registers and stream
 //! ports. [`generate`] turns it into the Rust tables (`src/regs.rs`), the typed Rust register
-//! trait (`src/regs_api.rs`), the C header, the Verilog include and the Markdown table, all in
-//! memory, so the `cargo regen` binary and the staleness test share one code path: the test
-//! cannot pass on output the binary would not write.
+//! trait (`src/regs_api.rs`), the C header, the Verilog include, the Markdown table and the
+//! Verilog register block (`rtl/sc_regs.v`), all in memory, so the `cargo regen` binary and the
+//! staleness test share one code path: the test cannot pass on output the binary would not
+//! write.
 
 pub mod description;
 mod emit;
@@ -33,6 +34,7 @@ pub const RUST_API_PATH: &str = "src/regs_api.rs";
 pub const C_PATH: &str = "generated/stereocal_regs.h";
 pub const VERILOG_PATH: &str = "generated/stereocal_regs.vh";
 pub const MARKDOWN_PATH: &str = "generated/registers.md";
+pub const VERILOG_REGS_PATH: &str = "rtl/sc_regs.v";
 
 /// Builds every output from the description's text.
 pub fn generate(source: &str) -> Result<Vec<Output>, RegenError> {
@@ -57,6 +59,10 @@ pub fn generate(source: &str) -> Result<Vec<Output>, RegenError> {
         Output {
             path: MARKDOWN_PATH,
             contents: emit::markdown::emit(&d),
+        },
+        Output {
+            path: VERILOG_REGS_PATH,
+            contents: emit::verilog_regs::emit(&d),
         },
     ])
 }

@@ -31,7 +31,9 @@ fn every_output_carries_the_banner() {
 
 #[test]
 fn every_committed_output_is_checked() {
-    use stereocal_hdl_regen::{C_PATH, MARKDOWN_PATH, RUST_API_PATH, RUST_PATH, VERILOG_PATH};
+    use stereocal_hdl_regen::{
+        C_PATH, MARKDOWN_PATH, RUST_API_PATH, RUST_PATH, VERILOG_PATH, VERILOG_REGS_PATH,
+    };
     let source = read_description(&hdl_interface_dir()).unwrap_or_else(|e| panic!("{e}"));
     let outputs = generate(&source).unwrap_or_else(|e| panic!("{e}"));
     let paths: Vec<&str> = outputs.iter().map(|o| o.path).collect();
@@ -42,7 +44,8 @@ fn every_committed_output_is_checked() {
             RUST_API_PATH,
             C_PATH,
             VERILOG_PATH,
-            MARKDOWN_PATH
+            MARKDOWN_PATH,
+            VERILOG_REGS_PATH
         ],
         "the staleness check covers exactly these files"
     );

@@ -1,4 +1,5 @@
-//! The generated C header and Verilog include must pass the tools that will consume them.
+//! The generated C header, Verilog include and Verilog register block must pass the tools that
+//! will consume them.
 //!
 //! Each test runs on the committed file (the staleness test ties it to the description).
 //! A missing tool skips the test with a message on stderr, except under `CI=true`, where it
@@ -8,7 +9,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use stereocal_hdl_regen::{hdl_interface_dir, C_PATH, VERILOG_PATH};
+use stereocal_hdl_regen::{hdl_interface_dir, C_PATH, VERILOG_PATH, VERILOG_REGS_PATH};
 
 fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true")
@@ -181,4 +182,63 @@ fn verilog_include_passes_iverilog() {
         .arg("-I")
         .arg(&include_dir)
         .args(&sources));
+}
+
+#[test]
+fn register_block_passes_verilator_lint() {
+    if !tool_available("verilator") {
+        return;
+    }
+    run(Command::new("verilator")
+        .args([
+            "--lint-only",
+            "-Wall",
+            "--language",
+            "1364-2005",
+            "--top-module",
+            "sc_regs",
+        ])
+        .arg(hdl_interface_dir().join(VERILOG_REGS_PATH)));
+}
+
+#[test]
+fn register_block_passes_iverilog() {
+    if !tool_available("iverilog") {
+        return;
+    }
+    let out = scratch("sc_regs_iverilog").join("sc_regs.vvp");
+    run(Command::new("iverilog")
+        .args(["-g2005", "-Wall", "-s", "sc_regs", "-o"])
+        .arg(&out)
+        .arg(hdl_interface_dir().join(VERILOG_REGS_PATH)));
+}
+
+/// `rtl/tb/sc_regs_tb.v` drives the committed block through every access type.
+#[test]
+fn register_block_testbench_passes() {
+    if !tool_available("iverilog") || !tool_available("vvp") {
+        return;
+    }
+    let rtl = hdl_interface_dir().join(VERILOG_REGS_PATH);
+    let tb = rtl
+        .parent()
+        .expect("rtl has a directory")
+        .join("tb/sc_regs_tb.v");
+    let out = scratch("sc_regs_tb").join("sc_regs_tb.vvp");
+    run(Command::new("iverilog")
+        .args(["-g2005", "-Wall", "-s", "sc_regs_tb", "-o"])
+        .arg(&out)
+        .arg(&rtl)
+        .arg(&tb));
+    let sim = Command::new("vvp")
+        .arg("-n")
+        .arg(&out)
+        .output()
+        .unwrap_or_else(|e| panic!("vvp: {e}"));
+    let log = String::from_utf8_lossy(&sim.stdout);
+    assert!(
+        sim.status.success() && log.lines().any(|l| l == "PASS sc_regs_tb"),
+        "sc_regs_tb failed:\n{log}{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
 }

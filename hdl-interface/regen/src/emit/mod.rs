@@ -5,6 +5,7 @@ pub mod markdown;
 pub mod rust;
 pub mod rust_api;
 pub mod verilog;
+pub mod verilog_regs;
 
 /// `0x4000_0000`-style hex with 16-bit groups, as Rust and the docs spell 32-bit words.
 pub fn hex32_grouped(v: u32) -> String {
