@@ -16,6 +16,8 @@
 //! byte after that first link frame must be identical: register answers, every frame's
 //! packets, their sequence numbers and CRCs.
 
+pub mod rtl;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;

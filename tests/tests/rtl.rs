@@ -1,0 +1,391 @@
+//! Co-simulation of the RTL front end (`hdl-interface/rtl`, top `sc_frontend`) against the
+//! register-level model: every observation port on every clock and the clocks to `done` must
+//! be identical (`stereocal_hil::rtl`). Run with `cargo test --release -p stereocal-hil rtl`.
+//!
+//! Without Verilator every test prints a loud SKIPPED line and passes, except under `CI=true`
+//! (where the build already fails).
+
+// Without the RTL model only the skip path is compiled.
+#![cfg_attr(
+    not(rtl_sim),
+    allow(dead_code, unused_imports, clippy::needless_return)
+)]
+
+use std::io::Write;
+
+use stereocal_firmware::fabric::Config;
+
+/// Whether the RTL model exists; prints the loud skip line when it does not.
+fn rtl_available(test: &str) -> bool {
+    match stereocal_hil::rtl::SKIP {
+        None => true,
+        Some(why) => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "RTL model missing under CI=true: {why}"
+            );
+            // Straight to stderr: the test harness captures `eprintln!` of passing tests.
+            let _ = writeln!(
+                std::io::stderr(),
+                "\n!!! SKIPPED {test}: RTL co-simulation not built: {why} !!!\n"
+            );
+            false
+        }
+    }
+}
+
+/// splitmix64: deterministic test images without an RNG dependency.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+}
+
+fn noise(w: usize, h: usize, seed: u64) -> Vec<u8> {
+    let mut r = Rng(seed);
+    (0..w * h).map(|_| r.next() as u8).collect()
+}
+
+/// Noise with structure: blobs of random brightness on a random background.
+fn blobs(w: usize, h: usize, seed: u64) -> Vec<u8> {
+    let mut r = Rng(seed);
+    let mut img: Vec<u8> = (0..w * h).map(|_| 96 + (r.next() % 32) as u8).collect();
+    for _ in 0..(w * h / 40).max(3) {
+        let (cx, cy) = (r.below(w as u64) as i64, r.below(h as u64) as i64);
+        let rad = 1 + r.below(4) as i64;
+        let v = r.next() as u8;
+        for y in (cy - rad).max(0)..(cy + rad + 1).min(h as i64) {
+            for x in (cx - rad).max(0)..(cx + rad + 1).min(w as i64) {
+                if (x - cx).pow(2) + (y - cy).pow(2) <= rad * rad {
+                    img[y as usize * w + x as usize] = v;
+                }
+            }
+        }
+    }
+    img
+}
+
+fn checkerboard(w: usize, h: usize, cell: usize) -> Vec<u8> {
+    (0..w * h)
+        .map(|i| {
+            if ((i % w) / cell + (i / w) / cell) % 2 == 0 {
+                0
+            } else {
+                255
+            }
+        })
+        .collect()
+}
+
+fn impulses(w: usize, h: usize, background: u8, step: usize) -> Vec<u8> {
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            if x % step == step / 2 && y % step == step / 2 {
+                255 - background
+            } else {
+                background
+            }
+        })
+        .collect()
+}
+
+fn config(w: u16, h: u16, octaves: u8) -> Config {
+    Config {
+        octaves,
+        ..Config::new(w, h)
+    }
+}
+
+#[cfg(rtl_sim)]
+mod sim {
+    use super::*;
+    use stereocal_firmware::fabric::RegisterFrontEnd;
+    use stereocal_hil::rtl::{back_to_back, cosim_frame, FrameRun, RtlFrontEnd};
+
+    /// The two models, reused frame after frame (every frame starts with `start`).
+    pub struct Bench {
+        model: Box<RegisterFrontEnd>,
+        rtl: RtlFrontEnd,
+    }
+
+    impl Bench {
+        pub fn new() -> Self {
+            Self {
+                model: Box::new(RegisterFrontEnd::new()),
+                rtl: RtlFrontEnd::new(),
+            }
+        }
+
+        /// One frame with pixels back to back, or with `stimulus` when given.
+        pub fn frame(
+            &mut self,
+            name: &str,
+            cfg: &Config,
+            img: &[u8],
+            stimulus: Option<Vec<Option<u8>>>,
+        ) -> FrameRun {
+            let stim = stimulus.unwrap_or_else(|| back_to_back(img));
+            let t = std::time::Instant::now();
+            match cosim_frame(&mut self.model, &mut self.rtl, cfg, &stim) {
+                Ok(run) => {
+                    eprintln!(
+                        "rtl {name}: {}x{} octaves {} sobel_scale {} edge {} thr {} off {}: \
+                         identical, done after {} clocks ({:.2} s); points {:?}, sobel {:?}",
+                        cfg.width,
+                        cfg.height,
+                        cfg.octaves,
+                        cfg.sobel_scale,
+                        cfg.edge_ratio,
+                        cfg.contrast_threshold,
+                        cfg.max_offset,
+                        run.clocks_to_done,
+                        t.elapsed().as_secs_f64(),
+                        run.counts.points,
+                        run.counts.sobel,
+                    );
+                    // The streams every configured octave must carry on any frame.
+                    for k in 0..cfg.octaves as usize {
+                        assert!(run.counts.g3[k] > 0, "{name}: no G3 in octave {k}");
+                        assert!(run.counts.dog[k] > 0, "{name}: no DoG in octave {k}");
+                        assert!(run.counts.sobel[k] > 0, "{name}: no Sobel in octave {k}");
+                        if k + 1 < cfg.octaves as usize {
+                            assert!(run.counts.sub[k] > 0, "{name}: no subsample out of {k}");
+                        }
+                    }
+                    run
+                }
+                Err(m) => panic!(
+                    "rtl {name} ({}x{} octaves {} sobel_scale {} edge {} thr {} off {}): \
+                     first mismatch at {m}",
+                    cfg.width,
+                    cfg.height,
+                    cfg.octaves,
+                    cfg.sobel_scale,
+                    cfg.edge_ratio,
+                    cfg.contrast_threshold,
+                    cfg.max_offset,
+                ),
+            }
+        }
+    }
+}
+
+#[test]
+fn rtl_random_images() {
+    if !rtl_available("rtl_random_images") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        let mut b = sim::Bench::new();
+        // (w, h, octaves, sobel_scale, edge_ratio, threshold, max_offset), seed
+        let cases = [
+            ((64, 48, 4, 1, 10, 256, 4096), 1),
+            ((37, 29, 4, 0, 0, 0, 8191), 2),
+            ((50, 41, 3, 2, 10, 64, 2048), 3),
+            ((23, 70, 2, 3, 0, 1024, 4096), 4),
+            ((96, 64, 4, 3, 10, 128, 8191), 5),
+            ((31, 17, 1, 1, 0, 256, 1000), 6),
+            ((120, 33, 4, 2, 0, 256, 4096), 7),
+            ((45, 45, 3, 0, 10, 512, 0), 8),
+        ];
+        let mut points = 0;
+        for ((w, h, octaves, sobel_scale, edge_ratio, thr, off), seed) in cases {
+            let cfg = Config {
+                sobel_scale,
+                edge_ratio,
+                contrast_threshold: thr,
+                max_offset: off,
+                ..config(w, h, octaves)
+            };
+            let img = if seed % 2 == 0 {
+                noise(w as usize, h as usize, seed)
+            } else {
+                blobs(w as usize, h as usize, seed)
+            };
+            let run = b.frame(&format!("random seed {seed}"), &cfg, &img, None);
+            points += run.counts.points.iter().sum::<u64>();
+        }
+        assert!(points > 0, "no point in any random image");
+    }
+}
+
+#[test]
+fn rtl_random_with_idle_clocks() {
+    if !rtl_available("rtl_random_with_idle_clocks") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        // Pixels with random gaps (clocks without a pixel) inside rows and between rows.
+        let mut b = sim::Bench::new();
+        for (w, h, octaves, seed) in [(40u16, 36u16, 4u8, 11u64), (29, 21, 3, 12)] {
+            let img = blobs(w as usize, h as usize, seed);
+            let mut r = Rng(seed);
+            let mut stim = Vec::new();
+            for &p in &img {
+                for _ in 0..[0, 0, 0, 1, 2, 5][r.below(6) as usize] {
+                    stim.push(None);
+                }
+                stim.push(Some(p));
+            }
+            let cfg = config(w, h, octaves);
+            let run = b.frame(&format!("idle clocks seed {seed}"), &cfg, &img, Some(stim));
+            assert!(run.counts.points.iter().sum::<u64>() > 0, "no point");
+        }
+    }
+}
+
+#[test]
+fn rtl_edge_cases() {
+    if !rtl_available("rtl_edge_cases") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        let mut b = sim::Bench::new();
+        let (w, h) = (48usize, 40usize);
+        let cases: Vec<(&str, Vec<u8>, u8)> = vec![
+            ("all black", vec![0; w * h], 1),
+            ("all white", vec![255; w * h], 0),
+            ("checkerboard 1", checkerboard(w, h, 1), 1),
+            ("checkerboard 4", checkerboard(w, h, 4), 2),
+            ("impulses on black", impulses(w, h, 0, 7), 1),
+            ("impulses on white", impulses(w, h, 255, 9), 3),
+        ];
+        for (name, img, sobel_scale) in cases {
+            for edge_ratio in [10, 0] {
+                let cfg = Config {
+                    sobel_scale,
+                    edge_ratio,
+                    ..config(w as u16, h as u16, 4)
+                };
+                let run = b.frame(name, &cfg, &img, None);
+                if name.starts_with("all") {
+                    assert_eq!(run.counts.points, [0; 4], "{name}: points on a flat image");
+                }
+                if name.starts_with("impulses") {
+                    assert!(run.counts.points[0] > 0, "{name}: no point at an impulse");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn rtl_maximum_width() {
+    if !rtl_available("rtl_maximum_width") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        let mut b = sim::Bench::new();
+        let (w, h) = (1280u16, 20u16);
+        let img = blobs(w as usize, h as usize, 21);
+        let run = b.frame("maximum width", &config(w, h, 4), &img, None);
+        assert!(run.counts.points.iter().sum::<u64>() > 0, "no point");
+        let cfg = Config {
+            sobel_scale: 0,
+            ..config(w, 3, 1)
+        };
+        b.frame(
+            "maximum width, 3 rows",
+            &cfg,
+            &noise(w as usize, 3, 22),
+            None,
+        );
+    }
+}
+
+#[test]
+fn rtl_minimum_sizes() {
+    if !rtl_available("rtl_minimum_sizes") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        let mut b = sim::Bench::new();
+        // The smallest frames Config::validate accepts per octave count (last octave 3x3),
+        // square and with one side at its minimum.
+        for (octaves, min) in [(1u8, 3u16), (2, 5), (3, 9), (4, 17)] {
+            for (w, h) in [(min, min), (min, 2 * min + 1), (2 * min + 3, min)] {
+                let cfg = config(w, h, octaves);
+                assert!(cfg.validate([1280, 640, 320, 160]).is_ok());
+                let smaller = config(w - 1, h, octaves);
+                if w == min {
+                    assert!(smaller.validate([1280, 640, 320, 160]).is_err());
+                }
+                for seed in [31u64, 32] {
+                    let img = noise(w as usize, h as usize, seed + w as u64 * 97 + h as u64);
+                    b.frame(&format!("minimum {octaves} octaves"), &cfg, &img, None);
+                }
+            }
+        }
+    }
+}
+
+/// A crop of a real photograph (ETH3D two-view "terrace"), read at run time.
+fn real_crop(w: usize, h: usize) -> Option<Vec<u8>> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/data/real/eth3d_two_view/terrace/im0.png"
+    );
+    if !std::path::Path::new(path).exists() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "real image missing under CI=true: {path}"
+        );
+        let _ = writeln!(
+            std::io::stderr(),
+            "\n!!! SKIPPING rtl_real_image: {path} not found !!!\n"
+        );
+        return None;
+    }
+    let img = image::open(path).expect("real image decodes").into_luma8();
+    let (iw, ih) = (img.width() as usize, img.height() as usize);
+    assert!(iw >= w && ih >= h, "real image smaller than the crop");
+    let (x0, y0) = ((iw - w) / 2, (ih - h) / 2);
+    let raw = img.into_raw();
+    Some(
+        (0..h)
+            .flat_map(|y| {
+                raw[(y0 + y) * iw + x0..(y0 + y) * iw + x0 + w]
+                    .iter()
+                    .copied()
+            })
+            .collect(),
+    )
+}
+
+#[test]
+fn rtl_real_image() {
+    if !rtl_available("rtl_real_image") {
+        return;
+    }
+    let (w, h) = (320usize, 200usize);
+    let Some(img) = real_crop(w, h) else { return };
+    #[cfg(rtl_sim)]
+    {
+        let mut b = sim::Bench::new();
+        let cfg = config(w as u16, h as u16, 4);
+        let run = b.frame("real image", &cfg, &img, None);
+        for k in 0..3 {
+            assert!(
+                run.counts.points[k] > 0,
+                "no point in octave {k} of the real image"
+            );
+        }
+    }
+    #[cfg(not(rtl_sim))]
+    let _ = img;
+}
