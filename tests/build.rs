@@ -25,8 +25,12 @@ fn main() {
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("hdl-interface/rtl"));
     let sim = root.join("hdl-interface/sim");
-    println!("cargo:rerun-if-changed={}", rtl.display());
+    // The RTL's own files (not the whole directory: testbenches under it do not matter), and
+    // the directory while it has no sc_frontend.v yet.
     println!("cargo:rerun-if-changed={}", sim.display());
+    if !rtl.join("sc_frontend.v").exists() {
+        println!("cargo:rerun-if-changed={}", rtl.display());
+    }
     let ci = env::var("CI").as_deref() == Ok("true");
 
     if let Err(why) = build(&rtl, &sim) {
@@ -54,6 +58,9 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
         .filter(|p| p.extension().is_some_and(|x| x == "v"))
         .collect();
     sources.sort();
+    for s in &sources {
+        println!("cargo:rerun-if-changed={}", s.display());
+    }
     if !sources.iter().any(|p| p.ends_with("sc_frontend.v")) {
         return Err(format!("{} has no sc_frontend.v", rtl.display()));
     }
