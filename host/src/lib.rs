@@ -25,3 +25,4 @@ pub mod subpixel;
 pub mod summary;
 pub mod synth;
 pub mod verge_csv;
+pub mod workload;

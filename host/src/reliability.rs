@@ -24,95 +24,24 @@ use rayon::prelude::*;
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_wire::Camera;
 
-use crate::calib::{CalibError, Calibration};
 use crate::driver::{Driver, DriverError, FrameOutcome, LinkStats, ReceivedFrame};
 use crate::estimator::{EstimatorConfig, VergeEstimator};
-use crate::eval::{fabric_size, sequence_calibration, EvalError};
 use crate::link::{BadRate, Device, FaultConfig, FaultCounts, FaultLink, InProcessLink, LinkError};
 use crate::session::fabric_config;
-use crate::synth::{SceneKind, Sequence, SequenceConfig, SynthError};
+use crate::workload::{Workload, WorkloadError};
 
 /// Why a reliability run failed (a fault never is a reason: those cost frames).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ReliabilityError {
     #[error(transparent)]
-    Synth(#[from] SynthError),
-    #[error("synthetic calibration: {0}")]
-    Calib(#[from] CalibError),
-    #[error(transparent)]
-    Size(#[from] EvalError),
+    Workload(#[from] WorkloadError),
     #[error("device link: {0}")]
     Link(#[from] LinkError),
     #[error("device: {0}")]
     Driver(#[from] DriverError),
     #[error(transparent)]
     Rate(#[from] BadRate),
-    #[error("frame {frame} was dropped by the renderer; the sweep needs every frame")]
-    DroppedFrame { frame: usize },
-}
-
-/// The rendered frames every run of a sweep shares.
-pub struct Workload {
-    calib: Calibration,
-    width: u16,
-    height: u16,
-    /// Left image, right image, timestamp.
-    pairs: Vec<(Vec<u8>, Vec<u8>, u64)>,
-}
-
-impl Workload {
-    /// Renders the road scene at `width` x `height` for `frames` frames from `seed`
-    /// (frames in parallel).
-    pub fn road(
-        frames: usize,
-        seed: u64,
-        width: u32,
-        height: u32,
-    ) -> Result<Self, ReliabilityError> {
-        let sequence = Sequence::builtin(
-            SceneKind::Road,
-            SequenceConfig {
-                width,
-                height,
-                frames,
-                seed,
-                ..SequenceConfig::for_scene(SceneKind::Road)
-            },
-        )?;
-        let (w, h) = fabric_size(&sequence)?;
-        let calib = sequence_calibration(&sequence)?;
-        let pairs = (0..sequence.len())
-            .into_par_iter()
-            .map(|index| {
-                let frame = sequence.frame(index)?;
-                let images = frame
-                    .images
-                    .ok_or(ReliabilityError::DroppedFrame { frame: index })?;
-                Ok((
-                    images.left.into_raw(),
-                    images.right.into_raw(),
-                    frame.timestamp_us,
-                ))
-            })
-            .collect::<Result<Vec<_>, ReliabilityError>>()?;
-        Ok(Self {
-            calib,
-            width: w,
-            height: h,
-            pairs,
-        })
-    }
-
-    /// Frame pairs.
-    pub fn len(&self) -> usize {
-        self.pairs.len()
-    }
-
-    /// Whether there are no frames.
-    pub fn is_empty(&self) -> bool {
-        self.pairs.is_empty()
-    }
 }
 
 /// What the host made of one frame id.
@@ -155,9 +84,11 @@ pub fn run(
     driver.enable()?;
     let estimator = VergeEstimator::new(workload.calib, EstimatorConfig::default());
     let mut delivered = Vec::new();
-    for (index, (left, right, timestamp_us)) in workload.pairs.iter().enumerate() {
+    for (index, pair) in workload.pairs.iter().enumerate() {
         driver.link_mut().set_active(burst.contains(&index));
-        driver.link_mut().submit_pair(left, right, *timestamp_us)?;
+        driver
+            .link_mut()
+            .submit_pair(&pair.left, &pair.right, workload.timestamp_us(index))?;
         for (frame_id, l, r) in drain_pairs(&mut driver, timeout)? {
             let result = match estimator.estimate(&l.features, &r.features) {
                 Ok(est) => PairResult::Estimated(est.verge_deg.to_bits()),

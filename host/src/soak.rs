@@ -21,13 +21,11 @@
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
-use crate::calib::CalibError;
-use crate::eval::{fabric_size, sequence_calibration, EvalError};
 use crate::link::{BadRate, FaultCounts, FaultLink, InProcessLink, LinkError};
 use crate::record::FrameStatus;
 use crate::reliability::FaultKind;
 use crate::session::{Session, SessionConfig, SessionError};
-use crate::synth::{SceneKind, Sequence, SequenceConfig, SynthError};
+use crate::workload::{Workload, WorkloadError};
 
 /// The accuracy bar of the synthetic road: median raw error on estimated frames (degrees).
 pub const MEDIAN_BAR_DEG: f64 = 0.01;
@@ -45,19 +43,13 @@ pub const SECTION_END: &str = "<!-- soak: end -->";
 #[non_exhaustive]
 pub enum SoakError {
     #[error(transparent)]
-    Synth(#[from] SynthError),
-    #[error("synthetic calibration: {0}")]
-    Calib(#[from] CalibError),
-    #[error(transparent)]
-    Size(#[from] EvalError),
+    Workload(#[from] WorkloadError),
     #[error("device link: {0}")]
     Link(#[from] LinkError),
     #[error(transparent)]
     Session(#[from] SessionError),
     #[error(transparent)]
     Rate(#[from] BadRate),
-    #[error("rendered frame {frame} was dropped by the renderer; the soak needs every frame")]
-    DroppedFrame { frame: usize },
     #[error("the soak needs at least one frame, one rendered pair and a sampling interval")]
     Empty,
 }
@@ -166,49 +158,30 @@ pub fn soak(config: SoakConfig, progress: &dyn Fn(usize)) -> Result<Soak, SoakEr
         return Err(SoakError::Empty);
     }
     let start = Instant::now();
-    let sequence = Sequence::builtin(
-        SceneKind::Road,
-        SequenceConfig {
-            width: config.width,
-            height: config.height,
-            frames: config.cycle,
-            seed: config.seed,
-            ..SequenceConfig::for_scene(SceneKind::Road)
-        },
-    )?;
-    let (w, h) = fabric_size(&sequence)?;
-    let size = (usize::from(w), usize::from(h));
-    let calib = sequence_calibration(&sequence)?;
-    // The cycled pairs: left, right, truth. Held once, for the whole soak.
-    let pairs = (0..sequence.len())
-        .map(|index| {
-            let frame = sequence.frame(index)?;
-            let images = frame
-                .images
-                .ok_or(SoakError::DroppedFrame { frame: index })?;
-            Ok((
-                images.left.into_raw(),
-                images.right.into_raw(),
-                frame.truth.verge_deg,
-            ))
-        })
-        .collect::<Result<Vec<_>, SoakError>>()?;
+    // The cycled pairs, held once for the whole soak.
+    let workload = Workload::road(config.cycle, config.seed, config.width, config.height)?;
+    let (w, h, size, calib) = (
+        workload.width,
+        workload.height,
+        workload.size(),
+        workload.calib,
+    );
 
     // The clean reference: each rendered pair once, without faults.
     let mut clean =
         Session::with_device(InProcessLink::new()?, calib, w, h, SessionConfig::default())?;
-    let mut reference = Vec::with_capacity(pairs.len());
-    for (index, (left, right, truth_deg)) in pairs.iter().enumerate() {
+    let mut reference = Vec::with_capacity(workload.len());
+    for (index, pair) in workload.pairs.iter().enumerate() {
         let record = clean.process(
             index,
-            Some((left, right)),
+            Some((&pair.left, &pair.right)),
             size,
-            sequence.timestamp_us(index),
-            Some(*truth_deg),
+            workload.timestamp_us(index),
+            Some(pair.truth_deg),
         )?;
         reference.push(Reference {
             raw_verge_deg: record.raw_verge_deg,
-            truth_deg: *truth_deg,
+            truth_deg: pair.truth_deg,
         });
     }
     drop(clean);
@@ -230,25 +203,25 @@ pub fn soak(config: SoakConfig, progress: &dyn Fn(usize)) -> Result<Soak, SoakEr
     let mut errors = Vec::new();
     let mut memory = Vec::new();
     for frame in 0..config.frames {
-        let slot = frame % pairs.len();
-        let (left, right, truth_deg) = &pairs[slot];
+        let slot = frame % workload.len();
+        let (pair, clean) = (&workload.pairs[slot], &reference[slot]);
         let record = session.process(
             frame,
-            Some((left, right)),
+            Some((&pair.left, &pair.right)),
             size,
-            sequence.timestamp_us(frame),
-            Some(*truth_deg),
+            workload.timestamp_us(frame),
+            Some(pair.truth_deg),
         )?;
         match record.status {
             FrameStatus::Dropped => dropped += 1,
             FrameStatus::Ok | FrameStatus::NoEstimate => {
                 delivered += 1;
-                let expected = reference[slot].raw_verge_deg.map(f64::to_bits);
+                let expected = clean.raw_verge_deg.map(f64::to_bits);
                 if record.raw_verge_deg.map(f64::to_bits) != expected {
                     wrong += 1;
                 }
                 if let Some(v) = record.raw_verge_deg {
-                    errors.push((v - truth_deg).abs());
+                    errors.push((v - pair.truth_deg).abs());
                 }
             }
         }

@@ -4,7 +4,8 @@
 use std::time::{Duration, Instant};
 
 use stereocal::link::{FaultConfig, FaultLink, Link, LinkError, ReplayLink};
-use stereocal::reliability::{judge, run, FaultKind, PairResult, Workload};
+use stereocal::reliability::{judge, run, FaultKind, PairResult};
+use stereocal::workload::Workload;
 
 const FRAMES: usize = 10;
 /// Faults on for frames 2..7; frames 7..10 show recovery.
@@ -197,9 +198,13 @@ fn a_short_soak_keeps_estimates_exact_and_samples_memory() {
     assert!(s.dropped > 0, "no frame was damaged: {s:?}");
     assert!(s.estimated > 0, "no frame was estimated: {s:?}");
     assert_eq!(s.wrong, 0, "{s:?}");
-    let median = s.median_deg.unwrap();
-    assert!(median <= MEDIAN_BAR_DEG, "median raw error {median}°");
-    assert!(s.accurate());
+    // Six rendered pairs are too few for the soak's own median to be a statistic (which pairs
+    // the faults happen to drop decides it): every delivered estimate equals the clean run's
+    // for its pair (`wrong == 0`), so the bar is checked on the clean run over the six pairs
+    // and the soak's worst error cannot exceed the clean worst.
+    let clean = s.clean_median_deg.unwrap();
+    assert!(clean <= MEDIAN_BAR_DEG, "clean median raw error {clean}°: {s:?}");
+    assert!(s.max_deg <= s.clean_max_deg, "{s:?}");
     // Memory plumbing (flatness is judged on the long soak: this test shares its process
     // with the others).
     if std::path::Path::new("/proc/self/status").exists() {
