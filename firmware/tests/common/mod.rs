@@ -71,11 +71,7 @@ pub fn real_image() -> Option<(Vec<u8>, usize, usize)> {
         env!("CARGO_MANIFEST_DIR"),
         "/../../shared/data/real/eth3d_two_view/terrace/im0.png"
     );
-    let alt = "/work/shared/data/real/eth3d_two_view/terrace/im0.png";
-    let p = [path, alt]
-        .into_iter()
-        .find(|p| std::path::Path::new(p).exists());
-    match p {
+    match Some(path).filter(|p| std::path::Path::new(p).exists()) {
         Some(p) => {
             let img = image::open(p).expect("real image decodes").into_luma8();
             let (w, h) = img.dimensions();
