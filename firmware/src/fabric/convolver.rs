@@ -48,7 +48,8 @@ pub fn da_dot(lut: &[u16; 32], s: [u16; 5]) -> u16 {
         for (j, &v) in s.iter().enumerate() {
             addr |= (((v >> b) & 1) as usize) << j;
         }
-        acc += (lut[addr] as u32) << b;
+        // `addr` has 5 bits (one per sample), so the mask is a no-op that rules out a panic.
+        acc += (lut[addr & 31] as u32) << b;
     }
     ((acc + (1 << (TAP_BITS - 1))) >> TAP_BITS) as u16
 }
@@ -117,7 +118,9 @@ impl RowConvolver {
             let mut win = [0u16; 5];
             for (k, w) in win.iter_mut().enumerate() {
                 let col = clamp_index(xc + k as i32 - 2, last);
-                *w = self.shift[(2 - (col - xc)) as usize];
+                // `col` is within xc-2..=xc+2, so the index is 0..=4; `min` only rules out
+                // a panic path.
+                *w = self.shift[((2 - (col - xc)) as usize).min(4)];
             }
             self.out = Some(da_dot(&self.lut, win));
             self.centre.advance(self.width);
@@ -193,7 +196,8 @@ impl<const W: usize> ColumnConvolver<W> {
             let mut win = [0u16; 5];
             for (k, w) in win.iter_mut().enumerate() {
                 let row = clamp_index(yc + k as i32 - 2, last);
-                *w = col[(self.pos.y as i32 - row) as usize];
+                // `row` is within y-4..=y, so the index is 0..=4 (`min` as above).
+                *w = col[((self.pos.y as i32 - row) as usize).min(4)];
             }
             self.out = Some(da_dot(&self.lut, win));
             self.emitted += 1;

@@ -1,6 +1,10 @@
 //! Bounded FIFO over `LINES` line memories of `W` entries (capacity `LINES·W`): the alignment
 //! delays between scale images and the output FIFOs the soft-core drains. Pushing into a full
 //! FIFO hands the value back; the caller counts it (nothing is dropped silently).
+//!
+//! Every access goes through `get`/`split_at_mut_checked`: the ring indices are below the
+//! capacity by construction, and should one not be, a push reports the FIFO full and a pop
+//! reports it empty instead of panicking.
 
 /// Circular FIFO of capacity `LINES * W`.
 #[derive(Clone, Debug)]
@@ -49,7 +53,10 @@ impl<T: Copy, const W: usize, const LINES: usize> LineFifo<T, W, LINES> {
         if i >= Self::CAPACITY {
             i -= Self::CAPACITY;
         }
-        self.mem.as_flattened_mut()[i] = v;
+        match self.mem.as_flattened_mut().get_mut(i) {
+            Some(slot) => *slot = v,
+            None => return Err(v),
+        }
         self.len += 1;
         Ok(())
     }
@@ -59,35 +66,42 @@ impl<T: Copy, const W: usize, const LINES: usize> LineFifo<T, W, LINES> {
         Self::CAPACITY - self.len
     }
 
-    /// Appends `n` entries `f(0), f(1), ..` (the caller checked `n <= self.free()`), writing
-    /// the at most two contiguous runs of the ring directly.
+    /// Appends the entries of `values` while there is room, writing the at most two
+    /// contiguous runs of the ring directly; returns how many were appended (the rest of
+    /// `values` is not consumed).
     #[inline]
-    pub fn extend_with(&mut self, n: usize, mut f: impl FnMut(usize) -> T) {
-        debug_assert!(n <= self.free());
+    pub fn extend(&mut self, values: impl IntoIterator<Item = T>) -> usize {
+        let mut values = values.into_iter();
         let mut start = self.head + self.len;
         if start >= Self::CAPACITY {
             start -= Self::CAPACITY;
         }
-        let first = n.min(Self::CAPACITY - start);
+        let free = self.free();
         let mem = self.mem.as_flattened_mut();
-        for (i, slot) in mem[start..start + first].iter_mut().enumerate() {
-            *slot = f(i);
+        let (before, after) = mem.split_at_mut_checked(start).unwrap_or_default();
+        // The free entries: from the write position to the end, then from the start.
+        let mut written = 0;
+        for run in [after, before] {
+            for slot in run.iter_mut().take(free - written) {
+                let Some(v) = values.next() else { break };
+                *slot = v;
+                written += 1;
+            }
         }
-        for (i, slot) in mem[..n - first].iter_mut().enumerate() {
-            *slot = f(first + i);
-        }
-        self.len += n;
+        self.len += written;
+        written
     }
 
     /// Hands every entry, oldest first, to `sink` as at most two slices, and empties the FIFO.
     pub fn drain_slices(&mut self, sink: &mut dyn FnMut(&[T])) {
         let mem = self.mem.as_flattened();
-        let first = self.len.min(Self::CAPACITY - self.head);
-        if first > 0 {
-            sink(&mem[self.head..self.head + first]);
+        let (before, after) = mem.split_at_checked(self.head).unwrap_or_default();
+        let first = self.len.min(after.len());
+        if let Some(run) = after.get(..first).filter(|run| !run.is_empty()) {
+            sink(run);
         }
-        if self.len > first {
-            sink(&mem[..self.len - first]);
+        if let Some(run) = before.get(..self.len - first).filter(|run| !run.is_empty()) {
+            sink(run);
         }
         self.clear();
     }
@@ -98,7 +112,7 @@ impl<T: Copy, const W: usize, const LINES: usize> LineFifo<T, W, LINES> {
         if self.len == 0 {
             return None;
         }
-        let v = self.mem.as_flattened()[self.head];
+        let v = *self.mem.as_flattened().get(self.head)?;
         self.head += 1;
         if self.head == Self::CAPACITY {
             self.head = 0;

@@ -2,6 +2,10 @@
 //! fabric, all addressed by the column counter). The row written `d` rows ago sits in slot
 //! `(current - d) mod N`; reads happen before the write of the same clock (read-first RAM), so
 //! `N` slots give delays 1..=N.
+//!
+//! Indexing cannot panic: the slot is taken `mod N` and the column is saturated at `W - 1`
+//! (the stages only pass columns below their configured width, which is at most `W`, so the
+//! saturation never changes a result; it only rules the panic path out).
 
 /// `N` line memories of `W` samples.
 #[derive(Clone, Debug)]
@@ -27,13 +31,13 @@ impl<T: Copy, const W: usize, const N: usize> LineBuffer<T, W, N> {
     /// Sample of column `x` written `delay` (1..=N) rows ago.
     #[inline]
     pub fn read(&self, x: usize, delay: usize) -> T {
-        self.mem[(self.current + N - delay) % N][x]
+        self.mem[(self.current + N - delay) % N][x.min(W - 1)]
     }
 
     /// Writes column `x` of the current row.
     #[inline]
     pub fn write(&mut self, x: usize, v: T) {
-        self.mem[self.current][x] = v;
+        self.mem[self.current % N][x.min(W - 1)] = v;
     }
 
     /// The current row is complete.

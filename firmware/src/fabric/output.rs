@@ -139,14 +139,16 @@ impl<const W0: usize> OutputFifos<W0> {
     #[inline]
     pub fn push_sobel_row(&mut self, octave: u8, y: u16, magnitude: &[u8], orientation: &[u8]) {
         let n = magnitude.len().min(orientation.len());
-        let fit = n.min(self.sobel.free());
-        self.sobel.extend_with(fit, |i| SobelPixel {
-            octave,
-            orientation: orientation[i],
-            magnitude: magnitude[i],
-            x: i as u16,
-            y,
-        });
+        let pixels = magnitude.iter().zip(orientation).enumerate();
+        let fit = self
+            .sobel
+            .extend(pixels.map(|(i, (&magnitude, &orientation))| SobelPixel {
+                octave,
+                orientation,
+                magnitude,
+                x: i as u16,
+                y,
+            }));
         self.overflow.sobel = self.overflow.sobel.saturating_add((n - fit) as u32);
     }
 

@@ -95,7 +95,10 @@ impl<T: Copy, const W: usize> WindowFormer<T, W> {
                 for (c, v) in wr.iter_mut().enumerate() {
                     let cx = clamp_index(xc + c as i32 - 1, xl);
                     // Column cx was formed xc + 1 - cx samples ago, holding rows yc-1..yc+1.
-                    *v = self.cols[(xc + 1 - cx) as usize][(row - yc + 1) as usize];
+                    // Both indices are 0..=2 (cx and row are within one of the centre);
+                    // `min` only rules out a panic path.
+                    let (ci, ri) = ((xc + 1 - cx) as usize, (row - yc + 1) as usize);
+                    *v = self.cols[ci.min(2)][ri.min(2)];
                 }
             }
             self.out = Some(Window3 {

@@ -1,5 +1,9 @@
 //! Row kernels of the fast path, written over equal-length slices so the compiler vectorises
 //! them. Integer results are identical to the register-level stages.
+//!
+//! No kernel can panic: each works on the common length of its slices (the callers pass
+//! equal lengths, so that is every pixel), the main loops run over sub-slices of exactly that
+//! length, and the border pixels are read with `get`.
 
 use crate::fabric::cordic::{CordicState, ATAN_BAM16};
 use crate::fabric::dog::dog;
@@ -7,9 +11,17 @@ use crate::fabric::taps::{Taps, TAP_BITS};
 
 const ROUND: u32 = 1 << (TAP_BITS - 1);
 
+/// `i` clamped to `0..=last` (replicated border); `min`/`max` rather than `clamp`, which
+/// asserts its bounds.
 #[inline(always)]
 fn clamp(i: isize, last: usize) -> usize {
-    i.clamp(0, last as isize) as usize
+    i.max(0).min(last as isize) as usize
+}
+
+/// `r[i]` at the clamped column `i`, or 0 if `r` is empty.
+#[inline(always)]
+fn at_clamped(r: &[u16], i: isize, last: usize) -> u16 {
+    r.get(clamp(i, last)).copied().unwrap_or(0)
 }
 
 /// Five 16x16-bit products widened to 32 bits (the form SSE2 multiplies with
@@ -23,14 +35,14 @@ fn dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u16 {
 
 /// Horizontal 5-tap filter of `src` into `dst` (same length), replicated border.
 pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
-    let w = src.len();
-    let dst = &mut dst[..w];
+    let w = src.len().min(dst.len());
+    let (src, dst) = (&src[..w], &mut dst[..w]);
     if w == 0 {
         return;
     }
     let last = w - 1;
     let border = |x: usize| {
-        let at = |k: isize| src[clamp(x as isize + k, last)];
+        let at = |k: isize| at_clamped(src, x as isize + k, last);
         dot(t, at(-2), at(-1), at(0), at(1), at(2))
     };
     if w >= 5 {
@@ -47,7 +59,9 @@ pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
             d[i] = dot(t, s0[i], s1[i], s2[i], s3[i], s4[i]);
         }
         for x in [0, 1, w - 2, w - 1] {
-            dst[x] = border(x);
+            if let Some(d) = dst.get_mut(x) {
+                *d = border(x);
+            }
         }
     } else {
         for (x, d) in dst.iter_mut().enumerate() {
@@ -58,7 +72,8 @@ pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
 
 /// Vertical 5-tap filter: `rows` are the input rows `y-2 ..= y+2` (already border-clamped).
 pub fn column_filter(t: &Taps, rows: [&[u16]; 5], dst: &mut [u16]) {
-    let n = dst.len();
+    let n = rows.iter().fold(dst.len(), |n, r| n.min(r.len()));
+    let dst = &mut dst[..n];
     let (r0, r1, r2, r3, r4) = (
         &rows[0][..n],
         &rows[1][..n],
@@ -73,8 +88,8 @@ pub fn column_filter(t: &Taps, rows: [&[u16]; 5], dst: &mut [u16]) {
 
 /// `dst[x] = dog(a[x], b[x])`.
 pub fn dog_row(a: &[u16], b: &[u16], dst: &mut [i16]) {
-    let n = dst.len();
-    let (a, b) = (&a[..n], &b[..n]);
+    let n = dst.len().min(a.len()).min(b.len());
+    let (a, b, dst) = (&a[..n], &b[..n], &mut dst[..n]);
     for i in 0..n {
         dst[i] = dog(a[i], b[i]);
     }
@@ -82,9 +97,12 @@ pub fn dog_row(a: &[u16], b: &[u16], dst: &mut [i16]) {
 
 /// Sobel of the centre row of `rows = [y-1, y, y+1]` (border-clamped), replicated columns.
 pub fn sobel_row(rows: [&[u16]; 3], sx: &mut [i32], sy: &mut [i32]) {
-    let w = sx.len();
+    let w = rows
+        .iter()
+        .fold(sx.len().min(sy.len()), |w, r| w.min(r.len()));
     let (a, b, c) = (&rows[0][..w], &rows[1][..w], &rows[2][..w]);
-    let at = |r: &[u16], i: isize| r[clamp(i, w - 1)] as i32;
+    let (sx, sy) = (&mut sx[..w], &mut sy[..w]);
+    let at = |r: &[u16], i: isize| at_clamped(r, i, w.saturating_sub(1)) as i32;
     let border = |x: usize| {
         let x = x as isize;
         let gx = (at(a, x + 1) + 2 * at(b, x + 1) + at(c, x + 1))
@@ -106,11 +124,13 @@ pub fn sobel_row(rows: [&[u16]; 3], sx: &mut [i32], sy: &mut [i32]) {
             dy[i] = (c0 + 2 * c1 + c2) - (a0 + 2 * a1 + a2);
         }
         for x in [0, w - 1] {
-            (sx[x], sy[x]) = border(x);
+            if let (Some(gx), Some(gy)) = (sx.get_mut(x), sy.get_mut(x)) {
+                (*gx, *gy) = border(x);
+            }
         }
     } else {
-        for x in 0..w {
-            (sx[x], sy[x]) = border(x);
+        for (x, (gx, gy)) in sx.iter_mut().zip(sy.iter_mut()).enumerate() {
+            (*gx, *gy) = border(x);
         }
     }
 }
@@ -118,8 +138,13 @@ pub fn sobel_row(rows: [&[u16]; 3], sx: &mut [i32], sy: &mut [i32]) {
 /// Branch-free CORDIC over a row: the same fold, rotations and rounding as
 /// [`crate::fabric::cordic::cordic`], written with selects so it vectorises.
 pub fn cordic_row(sx: &[i32], sy: &[i32], magnitude: &mut [u8], orientation: &mut [u8]) {
-    let n = magnitude.len();
-    let (sx, sy, orientation) = (&sx[..n], &sy[..n], &mut orientation[..n]);
+    let n = magnitude
+        .len()
+        .min(orientation.len())
+        .min(sx.len())
+        .min(sy.len());
+    let (sx, sy) = (&sx[..n], &sy[..n]);
+    let (magnitude, orientation) = (&mut magnitude[..n], &mut orientation[..n]);
     for i in 0..n {
         let s = fold_select(sx[i], sy[i]);
         let (mut x, mut y, mut z) = (s.x, s.y, s.z as i32);

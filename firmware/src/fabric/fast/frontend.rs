@@ -76,7 +76,9 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
             *d = (p as u16) << 8;
         }
         self.rows_in += 1;
-        let w = row.len();
+        // `row.len() == cfg.width <= W0` (checked above and by validation); `min` keeps the
+        // slice below in bounds by construction.
+        let w = row.len().min(W0);
         let Self {
             o0, input, fifos, ..
         } = self;

@@ -4,6 +4,10 @@
 //! input row `r + 2` arrives, or, once its input is complete, one pending row per tick (the row
 //! analogue of the register model's phantom samples). Scale rows live in 8-row rings, long
 //! enough for G0 row `r` to still be there when G3 row `r` appears (6 rows later).
+//!
+//! No index can panic: ring slots are taken modulo the ring length, and the row length is
+//! `width.min(W)` ([`FastOctave::row_len`]; `start` is only called with configurations
+//! validated against `W`, so the `min` never changes it), which bounds every `[..w]`.
 
 use crate::fabric::config::Config;
 use crate::fabric::edge::passes_edge_test;
@@ -93,7 +97,13 @@ impl<const W: usize> FastOctave<W> {
 
     /// The subsampled row produced by the last tick.
     pub(crate) fn sub_row(&self) -> &[u16] {
-        &self.sub[..self.sub_len]
+        &self.sub[..self.sub_len.min(W)]
+    }
+
+    /// Pixels per row: the octave's width, which validation keeps at most `W`.
+    #[inline(always)]
+    fn row_len(&self) -> usize {
+        (self.width as usize).min(W)
     }
 
     /// One row tick: a real row, or `None` (a phantom tick once the input is complete).
@@ -109,7 +119,7 @@ impl<const W: usize> FastOctave<W> {
         } else if self.rows_in < self.height {
             return false;
         }
-        let w = self.width as usize;
+        let w = self.row_len();
         let h = self.height;
         let mut emitted: [Option<u16>; 4] = [None; 4];
         for i in 0..4 {
@@ -120,7 +130,10 @@ impl<const W: usize> FastOctave<W> {
                     let r = c.rows_in;
                     c.rows_in += 1;
                     c.rows_out += 1;
-                    self.scale[0][r as usize % RING][..w].copy_from_slice(row);
+                    let dst = &mut self.scale[0][r as usize % RING][..w];
+                    for (d, &v) in dst.iter_mut().zip(row) {
+                        *d = v;
+                    }
                     probe.scale_row(self.index, 0, r, row);
                     emitted[0] = Some(r);
                 }
@@ -146,7 +159,7 @@ impl<const W: usize> FastOctave<W> {
             }
             if let Some(r) = emitted[i] {
                 let last = h as i32 - 1;
-                let slot = |k: i32| ((r as i32 + k).clamp(0, last) as usize) % 5;
+                let slot = |k: i32| ((r as i32 + k).max(0).min(last) as usize) % 5;
                 let f = &self.filtered[i];
                 let rows = [
                     &f[slot(-2)][..w],
@@ -176,10 +189,10 @@ impl<const W: usize> FastOctave<W> {
         if let Some(r) = emitted[3] {
             self.dog_and_extrema(r, out, probe);
             if r & 1 == 0 {
-                let g3 = &self.scale[3][r as usize % RING];
+                let g3 = &self.scale[3][r as usize % RING][..w];
                 self.sub_len = w.div_ceil(2);
-                for (j, s) in self.sub[..self.sub_len].iter_mut().enumerate() {
-                    *s = g3[2 * j];
+                for (s, &g) in self.sub.iter_mut().zip(g3.iter().step_by(2)) {
+                    *s = g;
                 }
                 return true;
             }
@@ -191,14 +204,14 @@ impl<const W: usize> FastOctave<W> {
     /// image is complete.
     fn sobel_tick<const W0: usize>(&mut self, out: &mut OutputFifos<W0>) {
         let s = self.config.sobel_scale as usize & 3;
-        let (w, h) = (self.width as usize, self.height);
+        let (w, h) = (self.row_len(), self.height);
         let have = self.count[s].rows_out;
         let r = self.sobel_rows;
         if r >= h || (r + 2 > have && have < h) {
             return;
         }
         let last = h as i32 - 1;
-        let slot = |k: i32| ((r as i32 + k).clamp(0, last) as usize) % RING;
+        let slot = |k: i32| ((r as i32 + k).max(0).min(last) as usize) % RING;
         let g = &self.scale[s];
         sobel_row(
             [&g[slot(-1)][..w], &g[slot(0)][..w], &g[slot(1)][..w]],
@@ -222,7 +235,7 @@ impl<const W: usize> FastOctave<W> {
         out: &mut OutputFifos<W0>,
         probe: &mut P,
     ) {
-        let w = self.width as usize;
+        let w = self.row_len();
         let slot = r as usize % RING;
         for i in 0..3 {
             let (a, b) = (&self.scale[i][slot], &self.scale[i + 1][slot]);
@@ -257,8 +270,9 @@ impl<const W: usize> FastOctave<W> {
             }
             let mut c: Cube = [[[0; 3]; 3]; 3];
             for (s, plane) in c.iter_mut().enumerate() {
-                for (y, row) in plane.iter_mut().enumerate() {
-                    row.copy_from_slice(&self.dog[s][rows[y]][x - 1..x + 2]);
+                for (row, &y) in plane.iter_mut().zip(&rows) {
+                    let d = &self.dog[s][y];
+                    *row = [d[x - 1], d[x], d[x + 1]];
                 }
             }
             if !is_extremum(&c, self.config.contrast_threshold)
