@@ -1,0 +1,507 @@
+// sc_fabric: the fabric of one camera channel, behind its AXI4-lite slave: the generated
+// register block (sc_regs), the 4-octave datapath (sc_frontend), the point FIFO (512 entries)
+// and the Sobel FIFO (3 x W0 entries, as the model's OutputFifos), the frame control and the
+// counters of the register map (hdl-interface/regmap.toml, version 2).
+//
+// Bus: sc_regs' simple synchronous bus (bus_we / bus_re one-clock strobes, registered
+// bus_rdata); a standard AXI4-lite front end drives it and `rst` (from !ARESETN).
+//
+// Frame control (CONTROL, STATUS):
+// - FRAME_ARM (ignored while BUSY) starts sc_frontend (its `start`: the configuration
+//   registers WIDTH, HEIGHT, OCTAVES, CONTRAST_THRESHOLD, EDGE_THRESHOLD.R,
+//   OUTPUT_MODE.SOBEL_SCALE and MAX_OFFSET are latched) and raises BUSY. The driver validates
+//   the configuration before writing it (FabricConfig::validate; the model's Config::validate
+//   on width <= W0 and the last octave >= 3 x 3): the RTL does not check it again.
+// - From the next clock PIXEL_IN is ready while CONTROL.ENABLE is 1. Pixels before the first
+//   one with SOF are taken and discarded; the SOF pixel is pixel (0, 0), and the frame is the
+//   next WIDTH x HEIGHT pixels taken (SOF/EOL inside the frame are not checked). Each taken
+//   pixel is one `clock(Some(p))` of the model; every other clock is `clock(None)`.
+// - After the last pixel PIXEL_IN is not ready until sc_frontend's `done` (every configured
+//   octave has emitted everything into the FIFOs): BUSY falls, STATUS.FRAME_DONE is set and
+//   FRAME_COUNT counts the frame.
+// - SOFT_RESET empties both FIFOs, returns to idle, restarts sc_frontend (clearing its valid
+//   bits), clears the STATUS flags, the overflow counters, FRAME_COUNT, LATENCY_CLOCKS and the
+//   holding registers. Configuration registers keep their values.
+//
+// FIFO entries, and arbitration between octaves: the four octaves may each push a point and a
+// Sobel pixel on the same clock. Both FIFOs take up to 4 entries per clock in octave order
+// o0, o1, o2, o3, the order in which the model's RegisterFrontEnd::clock pushes them (octave
+// k's items are pushed inside octave k's clock, octave 0 first), so the FIFO contents and the
+// overflow counts equal the model's entry for entry: each FIFO is 4 banks interleaved by slot
+// (no skid buffer, no stall; the datapath has no back-pressure, as the model). A pop on the
+// same clock as pushes frees its slot for the next clock (the model's driver pops between
+// clocks). POINT_OVERFLOW / SOBEL_OVERFLOW are set on a clock that dropped an entry.
+//
+// Reads: POINT_FIFO_DATA shows the head (VALID = level != 0; the whole word reads 0 when the
+// FIFO is empty, SCALE = 1 otherwise); its read pops the head and loads the point's DX/DY and
+// DS/DOG into the holding registers POINT_FIFO_DXDY / POINT_FIFO_DSDOG (zero when the FIFO
+// was empty). SOBEL_FIFO_DATA likewise with SOBEL_FIFO_POSITION.
+//
+// LATENCY_CLOCKS: clocks from the frame's first pixel (clock 0) to the clock on which octave
+// OCTAVES - 1 takes its first input sample (the model's first_input_clock(OCTAVES - 1):
+// sc_frontend's sub_valid[OCTAVES - 2] while oct_en[OCTAVES - 2], or the first pixel itself
+// with one octave), stored when it happens; it keeps the last frame's value until then.
+//
+// Widths: FIFO levels fit 16 bits (POINT_DEPTH, SOBEL_DEPTH <= 65535); point x < 2048 and
+// y < 2048 (11 bits in POINT_FIFO_DATA; W0 <= 2047, the map's max_height 1024); counters 32
+// bits; width * height < 2^32.
+`default_nettype none
+
+module sc_fabric #(
+    parameter W0 = 1280,                 // line memories of octave k: Wk (sc_frontend)
+    parameter W1 = 640,
+    parameter W2 = 320,
+    parameter W3 = 160,
+    parameter POINT_DEPTH = 512,         // point_fifo_depth; a multiple of 4
+    parameter SOBEL_DEPTH = 3 * W0       // sobel_fifo_depth = 3 x max_width; a multiple of 4
+) (
+    input  wire        clk,
+    input  wire        rst,              // synchronous, active high (from !ARESETN)
+    // Register bus (sc_regs): the AXI4-lite front end's side.
+    input  wire [7:0]  bus_addr,
+    input  wire [31:0] bus_wdata,
+    input  wire        bus_we,
+    input  wire        bus_re,
+    output wire [31:0] bus_rdata,
+    // PIXEL_IN (AXI4-stream rules).
+    input  wire [7:0]  pixel_in_data,
+    input  wire        pixel_in_valid,
+    output wire        pixel_in_ready,
+    input  wire        pixel_in_sof,
+    /* verilator lint_off UNUSEDSIGNAL */
+    input  wire        pixel_in_eol      // not checked: lines are counted by WIDTH
+    /* verilator lint_on UNUSEDSIGNAL */
+);
+
+    // ---------------------------------------------------------------------------------------
+    // Register block.
+    wire        control_enable, control_frame_arm, control_soft_reset;
+    wire        status_frame_done, status_point_overflow, status_sobel_overflow;
+    wire [15:0] width_value, height_value, contrast_threshold_value, max_offset_value;
+    wire [2:0]  octaves_count;
+    wire [4:0]  edge_threshold_r;
+    wire [1:0]  output_mode_sobel_scale;
+    wire        point_fifo_data_pop, sobel_fifo_data_pop;
+
+    wire        busy;
+    wire        frame_end;            // BUSY falls on this clock
+    wire        soft_reset = control_soft_reset;
+    reg  [31:0] frame_count;
+    reg  [31:0] latency;
+    reg  [31:0] hold_dxdy, hold_dsdog, hold_position;
+
+    // The driver's bit (OUTPUT_MODE.SOBEL_OUTPUT: rows or patches) and the sticky flags' values
+    // are not used by the fabric.
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire        output_mode_sobel_output;
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    // Point entry: {octave[1:0], dog, ds, dy, dx (16 bits each), y[10:0], x[10:0]} (88 bits);
+    // Sobel entry: {octave[1:0], ori[5:0], mag[7:0], y[15:0], x[15:0]} (48 bits).
+    wire [87:0] pf_head;
+    wire [47:0] sf_head;
+    wire        pf_nonempty, sf_nonempty;
+    // What word 0 shows: the head, or all zero when the FIFO is empty.
+    wire [87:0] pf_shown = pf_nonempty ? pf_head : 88'd0;
+    wire [47:0] sf_shown = sf_nonempty ? sf_head : 48'd0;
+    wire [15:0] pf_level16, sf_level16;
+    wire [31:0] pf_dropped32, sf_dropped32;
+    wire        pf_dropping, sf_dropping;
+
+    sc_regs u_regs (
+        .clk(clk), .rst(rst), .flags_clear(soft_reset),
+        .bus_addr(bus_addr), .bus_wdata(bus_wdata), .bus_we(bus_we), .bus_re(bus_re),
+        .bus_rdata(bus_rdata),
+        .control_enable(control_enable), .control_frame_arm(control_frame_arm),
+        .control_soft_reset(control_soft_reset),
+        .status_busy(busy),
+        .status_frame_done(status_frame_done), .status_frame_done_set(frame_end),
+        .status_point_overflow(status_point_overflow),
+        .status_point_overflow_set(pf_dropping),
+        .status_sobel_overflow(status_sobel_overflow),
+        .status_sobel_overflow_set(sf_dropping),
+        .width_value(width_value), .height_value(height_value),
+        .octaves_count(octaves_count),
+        .contrast_threshold_value(contrast_threshold_value),
+        .edge_threshold_r(edge_threshold_r),
+        .output_mode_sobel_output(output_mode_sobel_output),
+        .output_mode_sobel_scale(output_mode_sobel_scale),
+        .point_fifo_level_level(pf_level16), .sobel_fifo_level_level(sf_level16),
+        .point_overflow_count_count(pf_dropped32),
+        .sobel_overflow_count_count(sf_dropped32),
+        .frame_count_count(frame_count), .latency_clocks_clocks(latency),
+        .point_fifo_data_x(pf_shown[10:0]), .point_fifo_data_y(pf_shown[21:11]),
+        .point_fifo_data_octave(pf_shown[87:86]), .point_fifo_data_scale({1'b0, pf_nonempty}),
+        .point_fifo_data_valid(pf_nonempty), .point_fifo_data_pop(point_fifo_data_pop),
+        .point_fifo_dxdy_dx(hold_dxdy[15:0]), .point_fifo_dxdy_dy(hold_dxdy[31:16]),
+        .point_fifo_dsdog_ds(hold_dsdog[15:0]), .point_fifo_dsdog_dog(hold_dsdog[31:16]),
+        .sobel_fifo_data_magnitude(sf_shown[39:32]),
+        .sobel_fifo_data_orientation(sf_shown[45:40]),
+        .sobel_fifo_data_octave(sf_shown[47:46]),
+        .sobel_fifo_data_valid(sf_nonempty), .sobel_fifo_data_pop(sobel_fifo_data_pop),
+        .sobel_fifo_position_x(hold_position[15:0]),
+        .sobel_fifo_position_y(hold_position[31:16]),
+        .max_offset_value(max_offset_value)
+    );
+
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire unused_flags = status_frame_done | status_point_overflow | status_sobel_overflow;
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    // ---------------------------------------------------------------------------------------
+    // Frame control.
+    localparam [1:0] S_IDLE = 2'd0,   // no frame
+                     S_SOF = 2'd1,    // armed: waiting for the SOF pixel
+                     S_RUN = 2'd2,    // taking the frame's pixels
+                     S_FLUSH = 2'd3;  // every pixel in: the octaves drain
+
+    reg  [1:0]  state;
+    reg  [31:0] total;                // WIDTH x HEIGHT of the armed frame
+    reg  [31:0] taken;                // pixels of the frame fed so far
+    reg  [1:0]  last_octave;          // OCTAVES - 1 of the armed frame, 0..3
+    wire        fe_done;
+
+    assign busy = state != S_IDLE;
+    wire arm = control_frame_arm && !busy && !soft_reset && !rst;
+    assign pixel_in_ready = control_enable && !soft_reset
+                         && (state == S_SOF || state == S_RUN);
+    wire take = pixel_in_valid && pixel_in_ready;
+    wire feed = take && (state == S_RUN || pixel_in_sof);    // the pixel enters sc_frontend
+    wire last_pixel = feed && (taken + 32'd1 == total);
+    assign frame_end = state == S_FLUSH && fe_done && !soft_reset;
+
+    always @(posedge clk) begin
+        if (rst || soft_reset) begin
+            state <= S_IDLE;
+            taken <= 32'd0;
+        end else begin
+            case (state)
+                S_IDLE: if (arm) begin
+                    state <= S_SOF;
+                    taken <= 32'd0;
+                end
+                S_SOF, S_RUN: if (feed) begin
+                    state <= last_pixel ? S_FLUSH : S_RUN;
+                    taken <= taken + 32'd1;
+                end
+                default: if (fe_done) state <= S_IDLE;
+            endcase
+        end
+    end
+
+    always @(posedge clk) begin
+        if (arm) begin
+            total <= {16'd0, width_value} * {16'd0, height_value};
+            last_octave <= octaves_count[1:0] - 2'd1;   // OCTAVES 1..4 -> 0..3
+        end
+    end
+
+    always @(posedge clk) begin
+        if (rst || soft_reset) frame_count <= 32'd0;
+        else if (frame_end) frame_count <= frame_count + 32'd1;
+    end
+
+    // ---------------------------------------------------------------------------------------
+    // Datapath. Its `start` is FRAME_ARM's clock (or SOFT_RESET's), never a pixel clock, and
+    // `rst` and the clock after it: sc_frontend's control state has no other reset, and the
+    // clock after `rst` latches the configuration registers' reset values.
+    reg rst_d = 1'b0;
+    always @(posedge clk) rst_d <= rst;
+    wire fe_start = arm || soft_reset || rst || rst_d;
+    wire [3:0]   oct_en, pt_valid, sb_valid;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [3:0]   sub_valid;           // octave 3's: nothing follows it
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [63:0]  sub_data;
+    wire [383:0] pt_data;
+    wire [183:0] sb_data;
+    // Observation ports of the co-simulation: not used here.
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [15:0]  g_valid;
+    wire [255:0] g_data;
+    wire [3:0]   dog_valid;
+    wire [191:0] dog_data;
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    sc_frontend #(.W0(W0), .W1(W1), .W2(W2), .W3(W3)) u_frontend (
+        .clk(clk), .start(fe_start),
+        .cfg_width(width_value), .cfg_height(height_value), .cfg_octaves(octaves_count),
+        .cfg_contrast(contrast_threshold_value), .cfg_edge_ratio({3'd0, edge_threshold_r}),
+        .cfg_sobel_scale(output_mode_sobel_scale), .cfg_max_offset(max_offset_value),
+        .pix_valid(feed), .pix_data(pixel_in_data),
+        .done(fe_done), .oct_en(oct_en),
+        .g_valid(g_valid), .g_data(g_data), .dog_valid(dog_valid), .dog_data(dog_data),
+        .sub_valid(sub_valid), .sub_data(sub_data),
+        .pt_valid(pt_valid), .pt_data(pt_data), .sb_valid(sb_valid), .sb_data(sb_data)
+    );
+
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire unused_sub_data = |sub_data;    // only its valid bits time the latency
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    // ---------------------------------------------------------------------------------------
+    // LATENCY_CLOCKS. oct_in[k]: octave k takes an input sample on this clock.
+    wire [3:0]  oct_in = {sub_valid[2:0] & oct_en[2:0], feed};
+    reg         lat_wait;     // armed; the last octave's first input not seen yet
+    reg         lat_run;      // counting: the frame's first pixel has been fed
+    reg  [31:0] lat_count;    // clocks since the first pixel (from the clock after it)
+    wire [31:0] lat_now = lat_run ? lat_count : 32'd0;
+    always @(posedge clk) begin
+        if (rst || soft_reset) begin
+            lat_wait <= 1'b0;
+            lat_run <= 1'b0;
+            lat_count <= 32'd0;
+            latency <= 32'd0;
+        end else if (arm) begin
+            lat_wait <= 1'b1;
+            lat_run <= 1'b0;
+            lat_count <= 32'd0;
+        end else if (lat_wait) begin
+            if (oct_in[last_octave]) begin
+                latency <= lat_now;
+                lat_wait <= 1'b0;
+                lat_run <= 1'b0;
+            end else if (lat_run || feed) begin
+                lat_run <= 1'b1;
+                lat_count <= lat_now + 32'd1;
+            end
+        end
+    end
+
+    // ---------------------------------------------------------------------------------------
+    // FIFO inputs: item k is octave k's, valid only on a clock octave k advances.
+    wire [3:0]   pf_v = pt_valid & oct_en;
+    wire [3:0]   sf_v = sb_valid & oct_en;
+    wire [351:0] pf_in;               // item k at [k*88 +: 88]
+    wire [191:0] sf_in;               // item k at [k*48 +: 48]
+    // pt_data x/y bits 15..11 are zero (x < W0 <= 2047, y < 2048).
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [383:0] pt_all = pt_data;
+    /* verilator lint_on UNUSEDSIGNAL */
+    genvar k;
+    generate
+        for (k = 0; k < 4; k = k + 1) begin : g_item
+            localparam [1:0] OCT = k;
+            // pt_data[k*96 +: 96] = {dog, ds, dy, dx, y, x}.
+            assign pf_in[k*88 +: 88] = {OCT, pt_all[k*96+32 +: 64], pt_all[k*96+16 +: 11],
+                                        pt_all[k*96 +: 11]};
+            assign sf_in[k*48 +: 48] = {OCT, sb_data[k*46 +: 46]};
+        end
+    endgenerate
+
+    // ---------------------------------------------------------------------------------------
+    // Point FIFO: POINT_DEPTH (512) entries of 88 bits in 4 banks of
+    // pf_ROWS rows; slot i is bank i % 4, row i / 4. Up to 4 entries arrive per clock (one
+    // per octave): item k takes the write slot (pf_wrow, pf_wlane) + rank_k (rank_k = valid
+    // items of octaves below k), so the items of one clock land in distinct banks. With f free
+    // slots before the edge and n arrivals, the first min(n, f) in octave order are kept and
+    // the rest counted, as the model's pushes one after the other. A pop on the same edge
+    // frees its slot for the next clock.
+    localparam pf_ROWS = POINT_DEPTH / 4;
+    localparam pf_AW   = (pf_ROWS > 1) ? $clog2(pf_ROWS) : 1;   // row address bits
+    localparam pf_LW   = $clog2(POINT_DEPTH + 1);                    // level: 0..POINT_DEPTH
+    localparam [pf_LW-1:0] pf_FULL = POINT_DEPTH;
+    localparam integer      pf_LAST_I = pf_ROWS - 1;
+    localparam [pf_AW-1:0] pf_LAST = pf_LAST_I[pf_AW-1:0];
+
+    reg  [pf_AW-1:0] pf_wrow, pf_rrow;
+    reg  [1:0]        pf_wlane, pf_rlane;
+    reg  [pf_LW-1:0] pf_level;
+    reg  [31:0]       pf_dropped;    // saturating overflow count
+
+    // Ranks within the clock, 0..3, and the slot lane each item would take.
+    wire [2:0]  pf_r1 = {2'd0, pf_v[0]};
+    wire [2:0]  pf_r2 = pf_r1 + {2'd0, pf_v[1]};
+    wire [2:0]  pf_r3 = pf_r2 + {2'd0, pf_v[2]};
+    wire [2:0]  pf_n  = pf_r3 + {2'd0, pf_v[3]};              // arrivals, 0..4
+    wire [11:0] pf_rank = {pf_r3, pf_r2, pf_r1, 3'd0};         // item k at [k*3 +: 3]
+    wire [pf_LW-1:0] pf_free = pf_FULL - pf_level;
+    wire [2:0]  pf_acc = ({{(pf_LW-3){1'b0}}, pf_n} <= pf_free) ? pf_n : pf_free[2:0];
+    wire [2:0]  pf_drop = pf_n - pf_acc;                         // 0..4
+    wire [3:0]  pf_take;                                           // item k is kept
+    wire [15:0] pf_hit;                                            // [k*4 + b]: item k -> bank b
+    genvar pf_k;
+    generate
+        for (pf_k = 0; pf_k < 4; pf_k = pf_k + 1) begin : g_pf_item
+            wire [2:0] rank = pf_rank[pf_k*3 +: 3];
+            wire [1:0] lane = pf_wlane + rank[1:0];
+            assign pf_take[pf_k] = pf_v[pf_k] && (rank < pf_acc);
+            assign pf_hit[pf_k*4 +: 4] = {4{pf_take[pf_k]}} & (4'b0001 << lane);
+        end
+    endgenerate
+
+    // Bank b < wlane is written in the next row (the slots wrap past lane 3).
+    wire [3:0]        pf_wrap = ~(4'b1111 << pf_wlane);
+    wire [pf_AW-1:0] pf_wrow_next = (pf_wrow == pf_LAST) ? {pf_AW{1'b0}} : pf_wrow + 1'b1;
+    wire [pf_AW-1:0] pf_rrow_next = (pf_rrow == pf_LAST) ? {pf_AW{1'b0}} : pf_rrow + 1'b1;
+    wire              pf_pop = point_fifo_data_pop && (pf_level != {pf_LW{1'b0}});
+    wire [1:0]        pf_rlane_n = pf_rlane + {1'b0, pf_pop};
+    wire [pf_AW-1:0] pf_rrow_n = (pf_pop && pf_rlane == 2'd3) ? pf_rrow_next : pf_rrow;
+    wire [2:0]        pf_lane_sum = {1'b0, pf_wlane} + pf_acc;
+
+    // Each bank reads the head's row every clock (the head bank's word is the FIFO head from
+    // the next clock on); a write to the row being read is passed through.
+    wire [4*88-1:0] pf_q_all;
+    genvar pf_b;
+    generate
+        for (pf_b = 0; pf_b < 4; pf_b = pf_b + 1) begin : g_pf_bank
+            reg  [88-1:0] mem [0:pf_ROWS-1];
+            reg  [88-1:0] q;
+            wire            we = pf_hit[pf_b] | pf_hit[4 + pf_b] | pf_hit[8 + pf_b]
+                               | pf_hit[12 + pf_b];
+            wire [88-1:0] wd = ({88{pf_hit[pf_b]}}      & pf_in[0*88 +: 88])
+                               | ({88{pf_hit[4 + pf_b]}}  & pf_in[1*88 +: 88])
+                               | ({88{pf_hit[8 + pf_b]}}  & pf_in[2*88 +: 88])
+                               | ({88{pf_hit[12 + pf_b]}} & pf_in[3*88 +: 88]);
+            wire [pf_AW-1:0] wa = pf_wrap[pf_b] ? pf_wrow_next : pf_wrow;
+            always @(posedge clk) begin
+                if (we) mem[wa] <= wd;
+                q <= (we && wa == pf_rrow_n) ? wd : mem[pf_rrow_n];
+            end
+            assign pf_q_all[pf_b*88 +: 88] = q;
+        end
+    endgenerate
+    assign pf_head = pf_q_all[pf_rlane*88 +: 88];
+
+    always @(posedge clk) begin
+        if (rst || soft_reset) begin
+            pf_wrow <= {pf_AW{1'b0}};
+            pf_rrow <= {pf_AW{1'b0}};
+            pf_wlane <= 2'd0;
+            pf_rlane <= 2'd0;
+            pf_level <= {pf_LW{1'b0}};
+            pf_dropped <= 32'd0;
+        end else begin
+            pf_wlane <= pf_lane_sum[1:0];
+            if (pf_lane_sum[2]) pf_wrow <= pf_wrow_next;
+            pf_rlane <= pf_rlane_n;
+            pf_rrow <= pf_rrow_n;
+            pf_level <= pf_level + {{(pf_LW-3){1'b0}}, pf_acc} - {{(pf_LW-1){1'b0}}, pf_pop};
+            if (pf_dropped > 32'hFFFF_FFFF - {29'd0, pf_drop})
+                pf_dropped <= 32'hFFFF_FFFF;
+            else
+                pf_dropped <= pf_dropped + {29'd0, pf_drop};
+        end
+    end
+    // ---------------------------------------------------------------------------------------
+    // Sobel FIFO: SOBEL_DEPTH (3 x W0) entries of 48 bits in 4 banks of
+    // sf_ROWS rows; slot i is bank i % 4, row i / 4. Up to 4 entries arrive per clock (one
+    // per octave): item k takes the write slot (sf_wrow, sf_wlane) + rank_k (rank_k = valid
+    // items of octaves below k), so the items of one clock land in distinct banks. With f free
+    // slots before the edge and n arrivals, the first min(n, f) in octave order are kept and
+    // the rest counted, as the model's pushes one after the other. A pop on the same edge
+    // frees its slot for the next clock.
+    localparam sf_ROWS = SOBEL_DEPTH / 4;
+    localparam sf_AW   = (sf_ROWS > 1) ? $clog2(sf_ROWS) : 1;   // row address bits
+    localparam sf_LW   = $clog2(SOBEL_DEPTH + 1);                    // level: 0..SOBEL_DEPTH
+    localparam [sf_LW-1:0] sf_FULL = SOBEL_DEPTH;
+    localparam integer      sf_LAST_I = sf_ROWS - 1;
+    localparam [sf_AW-1:0] sf_LAST = sf_LAST_I[sf_AW-1:0];
+
+    reg  [sf_AW-1:0] sf_wrow, sf_rrow;
+    reg  [1:0]        sf_wlane, sf_rlane;
+    reg  [sf_LW-1:0] sf_level;
+    reg  [31:0]       sf_dropped;    // saturating overflow count
+
+    // Ranks within the clock, 0..3, and the slot lane each item would take.
+    wire [2:0]  sf_r1 = {2'd0, sf_v[0]};
+    wire [2:0]  sf_r2 = sf_r1 + {2'd0, sf_v[1]};
+    wire [2:0]  sf_r3 = sf_r2 + {2'd0, sf_v[2]};
+    wire [2:0]  sf_n  = sf_r3 + {2'd0, sf_v[3]};              // arrivals, 0..4
+    wire [11:0] sf_rank = {sf_r3, sf_r2, sf_r1, 3'd0};         // item k at [k*3 +: 3]
+    wire [sf_LW-1:0] sf_free = sf_FULL - sf_level;
+    wire [2:0]  sf_acc = ({{(sf_LW-3){1'b0}}, sf_n} <= sf_free) ? sf_n : sf_free[2:0];
+    wire [2:0]  sf_drop = sf_n - sf_acc;                         // 0..4
+    wire [3:0]  sf_take;                                           // item k is kept
+    wire [15:0] sf_hit;                                            // [k*4 + b]: item k -> bank b
+    genvar sf_k;
+    generate
+        for (sf_k = 0; sf_k < 4; sf_k = sf_k + 1) begin : g_sf_item
+            wire [2:0] rank = sf_rank[sf_k*3 +: 3];
+            wire [1:0] lane = sf_wlane + rank[1:0];
+            assign sf_take[sf_k] = sf_v[sf_k] && (rank < sf_acc);
+            assign sf_hit[sf_k*4 +: 4] = {4{sf_take[sf_k]}} & (4'b0001 << lane);
+        end
+    endgenerate
+
+    // Bank b < wlane is written in the next row (the slots wrap past lane 3).
+    wire [3:0]        sf_wrap = ~(4'b1111 << sf_wlane);
+    wire [sf_AW-1:0] sf_wrow_next = (sf_wrow == sf_LAST) ? {sf_AW{1'b0}} : sf_wrow + 1'b1;
+    wire [sf_AW-1:0] sf_rrow_next = (sf_rrow == sf_LAST) ? {sf_AW{1'b0}} : sf_rrow + 1'b1;
+    wire              sf_pop = sobel_fifo_data_pop && (sf_level != {sf_LW{1'b0}});
+    wire [1:0]        sf_rlane_n = sf_rlane + {1'b0, sf_pop};
+    wire [sf_AW-1:0] sf_rrow_n = (sf_pop && sf_rlane == 2'd3) ? sf_rrow_next : sf_rrow;
+    wire [2:0]        sf_lane_sum = {1'b0, sf_wlane} + sf_acc;
+
+    // Each bank reads the head's row every clock (the head bank's word is the FIFO head from
+    // the next clock on); a write to the row being read is passed through.
+    wire [4*48-1:0] sf_q_all;
+    genvar sf_b;
+    generate
+        for (sf_b = 0; sf_b < 4; sf_b = sf_b + 1) begin : g_sf_bank
+            reg  [48-1:0] mem [0:sf_ROWS-1];
+            reg  [48-1:0] q;
+            wire            we = sf_hit[sf_b] | sf_hit[4 + sf_b] | sf_hit[8 + sf_b]
+                               | sf_hit[12 + sf_b];
+            wire [48-1:0] wd = ({48{sf_hit[sf_b]}}      & sf_in[0*48 +: 48])
+                               | ({48{sf_hit[4 + sf_b]}}  & sf_in[1*48 +: 48])
+                               | ({48{sf_hit[8 + sf_b]}}  & sf_in[2*48 +: 48])
+                               | ({48{sf_hit[12 + sf_b]}} & sf_in[3*48 +: 48]);
+            wire [sf_AW-1:0] wa = sf_wrap[sf_b] ? sf_wrow_next : sf_wrow;
+            always @(posedge clk) begin
+                if (we) mem[wa] <= wd;
+                q <= (we && wa == sf_rrow_n) ? wd : mem[sf_rrow_n];
+            end
+            assign sf_q_all[sf_b*48 +: 48] = q;
+        end
+    endgenerate
+    assign sf_head = sf_q_all[sf_rlane*48 +: 48];
+
+    always @(posedge clk) begin
+        if (rst || soft_reset) begin
+            sf_wrow <= {sf_AW{1'b0}};
+            sf_rrow <= {sf_AW{1'b0}};
+            sf_wlane <= 2'd0;
+            sf_rlane <= 2'd0;
+            sf_level <= {sf_LW{1'b0}};
+            sf_dropped <= 32'd0;
+        end else begin
+            sf_wlane <= sf_lane_sum[1:0];
+            if (sf_lane_sum[2]) sf_wrow <= sf_wrow_next;
+            sf_rlane <= sf_rlane_n;
+            sf_rrow <= sf_rrow_n;
+            sf_level <= sf_level + {{(sf_LW-3){1'b0}}, sf_acc} - {{(sf_LW-1){1'b0}}, sf_pop};
+            if (sf_dropped > 32'hFFFF_FFFF - {29'd0, sf_drop})
+                sf_dropped <= 32'hFFFF_FFFF;
+            else
+                sf_dropped <= sf_dropped + {29'd0, sf_drop};
+        end
+    end
+    assign pf_nonempty = pf_level != {pf_LW{1'b0}};
+    assign sf_nonempty = sf_level != {sf_LW{1'b0}};
+    assign pf_level16 = {{(16 - pf_LW){1'b0}}, pf_level};
+    assign sf_level16 = {{(16 - sf_LW){1'b0}}, sf_level};
+    assign pf_dropped32 = pf_dropped;
+    assign sf_dropped32 = sf_dropped;
+    assign pf_dropping = pf_drop != 3'd0;
+    assign sf_dropping = sf_drop != 3'd0;
+
+    // Holding registers: loaded by the read that pops word 0 (zero when the FIFO was empty).
+    always @(posedge clk) begin
+        if (rst || soft_reset) begin
+            hold_dxdy <= 32'd0;
+            hold_dsdog <= 32'd0;
+            hold_position <= 32'd0;
+        end else begin
+            if (point_fifo_data_pop) begin
+                hold_dxdy <= pf_shown[53:22];     // {dy, dx}
+                hold_dsdog <= pf_shown[85:54];    // {dog, ds}
+            end
+            if (sobel_fifo_data_pop)
+                hold_position <= sf_shown[31:0];  // {y, x}
+        end
+    end
+
+endmodule
+
+`default_nettype wire
