@@ -110,12 +110,14 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
         .collect();
     generated.sort();
 
-    cc::Build::new()
-        .cpp(true)
+    // Every translation unit on its own, NUM_JOBS at a time: the model's code at -O2, the
+    // run-once construction code (`*__Slow.cpp`) at -O0, the Verilator runtime at -O1.
+    let mut base = cc::Build::new();
+    base.cpp(true)
         .std("c++17")
         .warnings(false)
-        .opt_level(2)
         .debug(false)
+        .cargo_metadata(false)
         .include(&mdir)
         .include(&include)
         .include(include.join("vltstd"))
@@ -125,13 +127,51 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
         .define("VM_TRACE", "0")
         .define("VM_TRACE_FST", "0")
         .define("VM_TRACE_VCD", "0")
-        .flag_if_supported("-faligned-new")
-        .flag_if_supported("-fcf-protection=none")
-        .flag_if_supported("-Wno-unused-parameter")
-        .files(&generated)
-        .file(include.join("verilated.cpp"))
-        .file(include.join("verilated_threads.cpp"))
-        .file(sim.join("sc_sim.cpp"))
+        .flag("-faligned-new");
+    let mut units: Vec<(PathBuf, u32)> = generated
+        .into_iter()
+        .map(|p| {
+            let slow = p.to_string_lossy().ends_with("__Slow.cpp");
+            (p, if slow { 0 } else { 2 })
+        })
+        .collect();
+    units.push((include.join("verilated.cpp"), 1));
+    units.push((include.join("verilated_threads.cpp"), 1));
+    units.push((sim.join("sc_sim.cpp"), 2));
+    // Largest first, so the long ones do not end up last on one core.
+    units.sort_by_key(|(p, _)| std::cmp::Reverse(fs::metadata(p).map_or(0, |m| m.len())));
+    let jobs = env::var("NUM_JOBS")
+        .ok()
+        .and_then(|j| j.parse::<usize>().ok())
+        .unwrap_or(2)
+        .clamp(1, 16);
+    let queue = std::sync::Mutex::new(units.into_iter());
+    let objects: Vec<PathBuf> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..jobs)
+            .map(|_| {
+                s.spawn(|| {
+                    let mut objs = Vec::new();
+                    loop {
+                        let next = queue.lock().expect("queue").next();
+                        let Some((file, opt)) = next else { break objs };
+                        objs.extend(
+                            base.clone()
+                                .opt_level(opt)
+                                .file(&file)
+                                .compile_intermediates(),
+                        );
+                    }
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().expect("C++ compile worker"))
+            .collect()
+    });
+    cc::Build::new()
+        .cpp(true)
+        .objects(&objects)
         .compile("sc_sim");
     println!("cargo:rustc-link-lib=pthread");
     println!("cargo:rustc-cfg=rtl_sim");

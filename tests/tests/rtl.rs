@@ -260,7 +260,7 @@ fn rtl_edge_cases() {
             ("all white", vec![255; w * h], 0),
             ("checkerboard 1", checkerboard(w, h, 1), 1),
             ("checkerboard 4", checkerboard(w, h, 4), 2),
-            ("impulses on black", impulses(w, h, 0, 7), 1),
+            ("impulses on black", impulses(w, h, 0, 9), 1),
             ("impulses on white", impulses(w, h, 255, 9), 3),
         ];
         for (name, img, sobel_scale) in cases {
@@ -275,7 +275,9 @@ fn rtl_edge_cases() {
                     assert_eq!(run.counts.points, [0; 4], "{name}: points on a flat image");
                 }
                 if name.starts_with("impulses") {
-                    assert!(run.counts.points[0] > 0, "{name}: no point at an impulse");
+                    // A one-pixel impulse is finer than octave 0's scales: its blobs are
+                    // octave 1 extrema (one per impulse at this spacing).
+                    assert!(run.counts.points[1] > 0, "{name}: no point at an impulse");
                 }
             }
         }
