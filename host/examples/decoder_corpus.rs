@@ -35,7 +35,10 @@ fn main() -> Result<()> {
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let left = window(&scene.join("im0.png"))?;
     let right = window(&scene.join("im1.png"))?;
-    for (mode, name) in [(SobelOutput::Rows, "rows"), (SobelOutput::Patches, "patches")] {
+    for (mode, name) in [
+        (SobelOutput::Rows, "rows"),
+        (SobelOutput::Patches, "patches"),
+    ] {
         let bytes = capture(&left, &right, mode)?;
         write_seeds(&bytes, name, &out)?;
     }
@@ -91,7 +94,11 @@ fn write_seeds(bytes: &[u8], mode: &str, out: &Path) -> Result<()> {
     let head = fitting(frames.iter());
     write(out, &format!("{mode}-head"), &frames[..head].concat())?;
     let tail = fitting(frames.iter().rev());
-    write(out, &format!("{mode}-tail"), &frames[frames.len() - tail..].concat())
+    write(
+        out,
+        &format!("{mode}-tail"),
+        &frames[frames.len() - tail..].concat(),
+    )
 }
 
 /// How many of `frames`, taken in order, fit together in [`CHUNK`] bytes (at least one).
