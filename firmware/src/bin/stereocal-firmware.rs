@@ -61,10 +61,10 @@ mod soft_core {
 
     /// Sends a packet through the shared link writer.
     fn send(packet: &PacketRepr<'_>) {
-        critical_section::with(|cs| {
+        with_link(|link| {
             // Every packet built here is within the wire limits; a failure would be a bug
             // that the host sees as a missing packet.
-            let _ = LINK.borrow_ref_mut(cs).send(packet);
+            let _ = link.send(packet);
         });
     }
 
@@ -73,8 +73,15 @@ mod soft_core {
     }
 
     /// Runs `f` with the link writer borrowed.
+    ///
+    /// Only this main loop borrows [`LINK`] outright, never nested; the logger merely tries
+    /// (and counts a log it could not send), so the borrow is never refused. Were it refused,
+    /// the firmware stops with the status of a firmware bug instead of panicking.
     fn with_link<R>(f: impl FnOnce(&mut PacketWriter<Uart0>) -> R) -> R {
-        critical_section::with(|cs| f(&mut LINK.borrow_ref_mut(cs)))
+        critical_section::with(|cs| match LINK.borrow(cs).try_borrow_mut() {
+            Ok(mut link) => f(&mut link),
+            Err(_) => stop(ExitCode::Panic),
+        })
     }
 
     fn stop(code: ExitCode) -> ! {
@@ -117,10 +124,14 @@ mod soft_core {
         last_good_seq: &mut u16,
         wait: bool,
     ) {
+        // `FrameInput::new` checked that there are 1 or 2 cameras.
+        let Some((first, others)) = channels.split_first_mut() else {
+            return;
+        };
         loop {
             let byte = match Uart0::device().try_read_byte() {
                 Some(byte) => byte,
-                None if wait && channels[0].bus_mut().read_field(&control::ENABLE) == 0 => {
+                None if wait && first.bus_mut().read_field(&control::ENABLE) == 0 => {
                     core::hint::spin_loop();
                     continue;
                 }
@@ -135,11 +146,11 @@ mod soft_core {
                 FeedResult::Success { header, packet, .. } => {
                     *last_good_seq = header.seq;
                     if let PacketRepr::RegisterWrite(w) = packet {
-                        for other in channels.iter_mut().skip(1) {
+                        for other in others.iter_mut() {
                             other.write_register(w.addr, w.value);
                         }
                     }
-                    let answered = with_link(|link| channels[0].handle_host_packet(&packet, link));
+                    let answered = with_link(|link| first.handle_host_packet(&packet, link));
                     if let Err(e) = answered {
                         let (code, detail) = e.report();
                         report(code, detail);
@@ -175,7 +186,10 @@ mod soft_core {
         // so that the mark after the frames is the main loop's own.
         let (boot_stack, _) = stack::high_water();
         stack::paint();
-        let channels = &mut channels[..usize::from(header.cameras)];
+        // `FrameInput::new` checked that there are 1 or 2 cameras.
+        let Some(channels) = channels.get_mut(..usize::from(header.cameras)) else {
+            stop(ExitCode::BadInput);
+        };
         if header.has_flag(FLAG_AUTOSTART) {
             send(&hello());
         }

@@ -14,9 +14,10 @@ use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use critical_section::{CriticalSection, RestoreState};
-use stereocal_wire::{LogRepr, PacketRepr, MAX_LOG_LEN};
+use stereocal_wire::{LogRepr, PacketRepr, DELIMITER, MAX_LOG_LEN};
 
-use crate::softcore::link::LINK;
+use crate::softcore::finisher::{self, ExitCode};
+use crate::softcore::link::{Uart0, LINK};
 use crate::softcore::panic;
 
 /// Log frames that were not sent (too long, or the link was busy).
@@ -82,7 +83,12 @@ unsafe impl defmt::Logger for UartLogger {
         // SAFETY: interrupts are off on the only hart: nothing else holds a reference.
         let state = unsafe { &mut *STATE.0.get() };
         if state.taken && !panic::is_panicking() {
-            panic!("defmt logger re-entered");
+            // A log call inside a log call is a firmware bug; defmt requires that `acquire`
+            // not return then. Stop with the bug status (as the panic handler would, without
+            // linking a panic path): end the interrupted frame with a lone delimiter first.
+            Uart0::device().write_byte(DELIMITER);
+            // SAFETY: the firmware only runs on QEMU `virt`, which has the finisher.
+            unsafe { finisher::exit(ExitCode::Panic) }
         }
         // While panicking, a frame the panic interrupted is abandoned.
         state.taken = true;
@@ -119,7 +125,11 @@ unsafe impl defmt::Logger for UartLogger {
         } else {
             // SAFETY: we are inside the critical section taken in `acquire`.
             let cs = unsafe { CriticalSection::new() };
-            send(cs, &state.frame[..state.len]);
+            match state.frame.get(..state.len) {
+                Some(frame) => send(cs, frame),
+                // `append` keeps `len` within the frame; counted like a too-long frame.
+                None => count_dropped(),
+            }
         }
         state.taken = false;
         // SAFETY: `restore` is what `acquire` got from the matching `critical_section::acquire`.
