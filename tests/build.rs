@@ -77,7 +77,7 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
             "--x-assign",
             "fast",
             "--x-initial",
-            "fast",
+            "unique",
             "--noassert",
         ])
         .args(["-Wno-fatal", "-Wno-lint", "-Wno-style"])

@@ -56,10 +56,14 @@ void edge(sc_sim *s) {
 
 extern "C" {
 
-sc_sim *sc_sim_new(void) {
+sc_sim *sc_sim_new(uint32_t rand_seed) {
     sc_sim *s = new (std::nothrow) sc_sim;
     if (!s) return nullptr;
     s->ctx = new VerilatedContext;
+    if (rand_seed != 0) {
+        s->ctx->randReset(2);
+        s->ctx->randSeed(static_cast<int>(rand_seed & 0x7fffffff));
+    }
     s->top = new Vsc_frontend{s->ctx, "sc_frontend"};
     s->top->clk = 0;
     s->top->start = 0;

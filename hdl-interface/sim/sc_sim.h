@@ -43,8 +43,10 @@ typedef struct {
 
 typedef struct sc_sim sc_sim;
 
-/* A new model in its own VerilatedContext (inputs low, clk low); NULL on failure. */
-sc_sim *sc_sim_new(void);
+/* A new model in its own VerilatedContext (inputs low, clk low); NULL on failure.
+ * rand_seed = 0: every register and memory powers up 0; otherwise they power up to random
+ * values drawn from rand_seed (Verilator's randReset 2). */
+sc_sim *sc_sim_new(uint32_t rand_seed);
 /* Finalizes and frees the model. */
 void sc_sim_free(sc_sim *sim);
 /* One clock with start = 1, cfg_* = *cfg and pix_valid = 0 (= start_frame). */

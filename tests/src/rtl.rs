@@ -160,7 +160,7 @@ mod ffi {
     }
 
     extern "C" {
-        pub fn sc_sim_new() -> *mut Sim;
+        pub fn sc_sim_new(rand_seed: u32) -> *mut Sim;
         pub fn sc_sim_free(sim: *mut Sim);
         pub fn sc_sim_start(sim: *mut Sim, cfg: *const SimConfig);
         pub fn sc_sim_clock(sim: *mut Sim, pix_valid: c_int, pix_data: u8, obs: *mut SimObs);
@@ -196,8 +196,14 @@ impl Default for RtlFrontEnd {
 
 #[cfg(rtl_sim)]
 impl RtlFrontEnd {
-    /// A fresh model (inputs low).
+    /// A fresh model (inputs low), every register and memory at 0.
     pub fn new() -> Self {
+        Self::with_power_up(0)
+    }
+
+    /// A fresh model whose registers and memories power up to random values drawn from
+    /// `seed` (0: all zero).
+    pub fn with_power_up(seed: u32) -> Self {
         // SAFETY: plain C calls without arguments.
         let size = unsafe { ffi::sc_sim_obs_size() } as usize;
         assert_eq!(
@@ -206,7 +212,7 @@ impl RtlFrontEnd {
             "sc_sim_obs layout differs between sc_sim.h and rtl.rs"
         );
         // SAFETY: as above.
-        let sim = std::ptr::NonNull::new(unsafe { ffi::sc_sim_new() }).expect("sc_sim_new");
+        let sim = std::ptr::NonNull::new(unsafe { ffi::sc_sim_new(seed) }).expect("sc_sim_new");
         Self {
             sim,
             obs: ffi::SimObs::default(),
@@ -283,6 +289,23 @@ fn probe_of(o: &ffi::SimObs) -> ClockProbe {
     p
 }
 
+/// Starts both sides with `cfg` and runs exactly `stimulus.len()` clocks (`None` = no pixel),
+/// comparing every observation signal on every clock and `done` after every clock; returns
+/// what flowed. The frame need not be complete (an aborted frame).
+#[cfg(rtl_sim)]
+pub fn cosim_clocks(
+    model: &mut RegisterFrontEnd,
+    rtl: &mut RtlFrontEnd,
+    cfg: &Config,
+    stimulus: &[Option<u8>],
+) -> Result<StreamCounts, Box<Mismatch>> {
+    let mut run = Lockstep::start(model, rtl, cfg);
+    for &pixel in stimulus {
+        run.clock(pixel)?;
+    }
+    Ok(run.counts)
+}
+
 /// Runs one frame through `model` and `rtl` side by side: `start` with `cfg`, then one clock
 /// per element of `stimulus` (`None` = no pixel), then blanking clocks until both are done.
 /// Compares every observation signal on every clock and `done` after every clock.
@@ -299,21 +322,59 @@ pub fn cosim_frame(
         cfg.width as usize * cfg.height as usize,
         "one pixel per position"
     );
-    model.start_frame(cfg).expect("valid configuration");
-    rtl.start(cfg);
-    let mut counts = StreamCounts::default();
+    let mut run = Lockstep::start(model, rtl, cfg);
     let limit = stimulus.len() as u64 + flush_bound(cfg);
-    let mut pixels_in = 0u64;
-    let mut clock = 0u64;
     loop {
-        let pixel = stimulus.get(clock as usize).copied().flatten();
-        pixels_in += pixel.is_some() as u64;
-        model.clock(pixel);
+        let pixel = stimulus.get(run.clock as usize).copied().flatten();
+        let done = run.clock(pixel)?;
+        if done && run.clock >= stimulus.len() as u64 {
+            return Ok(FrameRun {
+                clocks_to_done: run.clock,
+                counts: run.counts,
+            });
+        }
+        assert!(
+            run.clock < limit,
+            "neither side done {} clocks after the last pixel",
+            flush_bound(cfg)
+        );
+    }
+}
+
+/// The two sides clocked together.
+#[cfg(rtl_sim)]
+struct Lockstep<'a> {
+    model: &'a mut RegisterFrontEnd,
+    rtl: &'a mut RtlFrontEnd,
+    counts: StreamCounts,
+    pixels_in: u64,
+    clock: u64,
+}
+
+#[cfg(rtl_sim)]
+impl<'a> Lockstep<'a> {
+    fn start(model: &'a mut RegisterFrontEnd, rtl: &'a mut RtlFrontEnd, cfg: &Config) -> Self {
+        model.start_frame(cfg).expect("valid configuration");
+        rtl.start(cfg);
+        Self {
+            model,
+            rtl,
+            counts: StreamCounts::default(),
+            pixels_in: 0,
+            clock: 0,
+        }
+    }
+
+    /// One clock on both sides; `Ok(done)` when everything matched.
+    fn clock(&mut self, pixel: Option<u8>) -> Result<bool, Box<Mismatch>> {
+        self.pixels_in += pixel.is_some() as u64;
+        self.model.clock(pixel);
         // The point and Sobel FIFOs of the model are not the RTL's: keep them drained.
-        while model.pop_point().is_some() {}
-        while model.pop_sobel().is_some() {}
-        let (rtl_probe, rtl_done) = rtl.clock(pixel);
-        let rust_probe = model.probe();
+        while self.model.pop_point().is_some() {}
+        while self.model.pop_sobel().is_some() {}
+        let (rtl_probe, rtl_done) = self.rtl.clock(pixel);
+        let rust_probe = self.model.probe();
+        let (clock, pixels_in) = (self.clock, self.pixels_in);
         let mismatch = |octave, (signal, rust, rtl)| {
             Box::new(Mismatch {
                 clock,
@@ -329,8 +390,8 @@ pub fn cosim_frame(
                 return Err(mismatch(Some(k), d));
             }
         }
-        count(&mut counts, rust_probe);
-        let rust_done = model.octaves_done();
+        count(&mut self.counts, rust_probe);
+        let rust_done = self.model.octaves_done();
         if rust_done != rtl_done {
             let d = (
                 "done".to_string(),
@@ -339,17 +400,7 @@ pub fn cosim_frame(
             );
             return Err(mismatch(None, d));
         }
-        clock += 1;
-        if rust_done && clock >= stimulus.len() as u64 {
-            return Ok(FrameRun {
-                clocks_to_done: clock,
-                counts,
-            });
-        }
-        assert!(
-            clock < limit,
-            "neither side done {} clocks after the last pixel",
-            flush_bound(cfg)
-        );
+        self.clock += 1;
+        Ok(rust_done)
     }
 }

@@ -99,6 +99,21 @@ fn impulses(w: usize, h: usize, background: u8, step: usize) -> Vec<u8> {
         .collect()
 }
 
+/// Even-sized bright squares on black: their centres fall between pixels, so DoG maxima are
+/// plateaus of equal samples (no extremum by the strict comparison).
+fn even_squares(w: usize, h: usize, side: usize, step: usize) -> Vec<u8> {
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            if x % step < side && y % step < side {
+                200
+            } else {
+                20
+            }
+        })
+        .collect()
+}
+
 fn config(w: u16, h: u16, octaves: u8) -> Config {
     Config {
         octaves,
@@ -110,7 +125,9 @@ fn config(w: u16, h: u16, octaves: u8) -> Config {
 mod sim {
     use super::*;
     use stereocal_firmware::fabric::RegisterFrontEnd;
-    use stereocal_hil::rtl::{back_to_back, cosim_frame, FrameRun, RtlFrontEnd};
+    use stereocal_hil::rtl::{
+        back_to_back, cosim_clocks, cosim_frame, FrameRun, RtlFrontEnd, StreamCounts,
+    };
 
     /// The two models, reused frame after frame (every frame starts with `start`).
     pub struct Bench {
@@ -120,10 +137,21 @@ mod sim {
 
     impl Bench {
         pub fn new() -> Self {
+            Self::with_power_up(0)
+        }
+
+        /// The RTL's registers and memories at random power-up values from `seed` (0: zero).
+        pub fn with_power_up(seed: u32) -> Self {
             Self {
                 model: Box::new(RegisterFrontEnd::new()),
-                rtl: RtlFrontEnd::new(),
+                rtl: RtlFrontEnd::with_power_up(seed),
             }
+        }
+
+        /// `start`, then exactly `stimulus.len()` clocks (a frame left unfinished).
+        pub fn partial(&mut self, name: &str, cfg: &Config, stim: &[Option<u8>]) -> StreamCounts {
+            cosim_clocks(&mut self.model, &mut self.rtl, cfg, stim)
+                .unwrap_or_else(|m| panic!("rtl {name} (unfinished frame): first mismatch at {m}"))
         }
 
         /// One frame with pixels back to back, or with `stimulus` when given.
@@ -221,6 +249,44 @@ fn rtl_random_images() {
 }
 
 #[test]
+fn rtl_random_configurations() {
+    if !rtl_available("rtl_random_configurations") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        // Sizes, octave counts and every other setting drawn at random (valid ones only).
+        let mut b = sim::Bench::new();
+        let mut r = Rng(0x5eed);
+        let mut points = 0;
+        let mut frames = 0;
+        while frames < 40 {
+            let (w, h) = (3 + r.below(160) as u16, 3 + r.below(90) as u16);
+            let cfg = Config {
+                octaves: 1 + r.below(4) as u8,
+                contrast_threshold: [0, 32, 128, 256, 700, 4000][r.below(6) as usize],
+                edge_ratio: [0, 1, 5, 10, 12, 255][r.below(6) as usize],
+                sobel_scale: r.below(4) as u8,
+                max_offset: r.below(8192) as u16,
+                ..Config::new(w, h)
+            };
+            if cfg.validate([1280, 640, 320, 160]).is_err() {
+                continue;
+            }
+            let seed = r.next();
+            let img = match seed % 3 {
+                0 => noise(w as usize, h as usize, seed),
+                _ => blobs(w as usize, h as usize, seed),
+            };
+            let run = b.frame(&format!("random configuration {frames}"), &cfg, &img, None);
+            points += run.counts.points.iter().sum::<u64>();
+            frames += 1;
+        }
+        assert!(points > 0, "no point in any random configuration");
+    }
+}
+
+#[test]
 fn rtl_random_with_idle_clocks() {
     if !rtl_available("rtl_random_with_idle_clocks") {
         return;
@@ -247,6 +313,75 @@ fn rtl_random_with_idle_clocks() {
 }
 
 #[test]
+fn rtl_configuration_sweep() {
+    if !rtl_available("rtl_configuration_sweep") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        // Every octave count x Sobel scale x edge ratio, thresholds and offsets cycling.
+        let mut b = sim::Bench::new();
+        let thresholds = [0u16, 64, 256, 1024, 65535];
+        let offsets = [0u16, 1000, 4096, 8191, 2048, 7000];
+        let mut i = 0usize;
+        let mut points = 0;
+        for octaves in 1..=4u8 {
+            for sobel_scale in 0..=3u8 {
+                for edge_ratio in [0u8, 10] {
+                    let (w, h) = (40 + 7 * (i % 5) as u16, 34 + 5 * (i % 3) as u16);
+                    let cfg = Config {
+                        sobel_scale,
+                        edge_ratio,
+                        contrast_threshold: thresholds[i % thresholds.len()],
+                        max_offset: offsets[i % offsets.len()],
+                        ..config(w, h, octaves)
+                    };
+                    let img = blobs(w as usize, h as usize, 100 + i as u64);
+                    let run = b.frame(&format!("sweep {i}"), &cfg, &img, None);
+                    points += run.counts.points.iter().sum::<u64>();
+                    i += 1;
+                }
+            }
+        }
+        assert!(points > 0, "no point in the sweep");
+    }
+}
+
+#[test]
+fn rtl_aborted_frames_and_power_up() {
+    if !rtl_available("rtl_aborted_frames_and_power_up") {
+        return;
+    }
+    #[cfg(rtl_sim)]
+    {
+        // Registers and memories power up random; frames are abandoned part way (in the
+        // middle of the image, during the flush) and restarted with another size: `start`
+        // must leave nothing behind that reaches an output.
+        for seed in [1u32, 77] {
+            let mut b = sim::Bench::with_power_up(seed);
+            let (w, h) = (52u16, 44u16);
+            let img = blobs(w as usize, h as usize, seed as u64);
+            let cfg = config(w, h, 4);
+            for cut in [0usize, 1, 700, (w as usize * h as usize)] {
+                let mut stim = back_to_back(&img[..cut]);
+                stim.extend(std::iter::repeat_n(None, 150 * (seed as usize % 3)));
+                b.partial("aborted", &cfg, &stim);
+            }
+            let cfg2 = Config {
+                sobel_scale: 2,
+                ..config(37, 61, 3)
+            };
+            let img2 = noise(37, 61, seed as u64 + 5);
+            b.frame("after aborted frames", &cfg2, &img2, None);
+            b.frame("random power-up", &cfg, &img, None);
+        }
+    }
+}
+
+#[cfg(rtl_sim)]
+use stereocal_hil::rtl::back_to_back;
+
+#[test]
 fn rtl_edge_cases() {
     if !rtl_available("rtl_edge_cases") {
         return;
@@ -262,6 +397,8 @@ fn rtl_edge_cases() {
             ("checkerboard 4", checkerboard(w, h, 4), 2),
             ("impulses on black", impulses(w, h, 0, 9), 1),
             ("impulses on white", impulses(w, h, 255, 9), 3),
+            ("2x2 squares", even_squares(w, h, 2, 9), 1),
+            ("4x4 squares", even_squares(w, h, 4, 12), 0),
         ];
         for (name, img, sobel_scale) in cases {
             for edge_ratio in [10, 0] {
@@ -336,26 +473,27 @@ fn rtl_minimum_sizes() {
     }
 }
 
-/// A crop of a real photograph (ETH3D two-view "terrace"), read at run time.
-fn real_crop(w: usize, h: usize) -> Option<Vec<u8>> {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/data/real/eth3d_two_view/terrace/im0.png"
+/// A centred `w` x `h` crop of a real photograph under ../shared/data/real, read at run time
+/// (`None`, loudly, when the data set is absent outside CI).
+fn real_crop(rel: &str, w: usize, h: usize) -> Option<Vec<u8>> {
+    let path = format!(
+        "{}/../../shared/data/real/{rel}",
+        env!("CARGO_MANIFEST_DIR")
     );
-    if !std::path::Path::new(path).exists() {
+    if !std::path::Path::new(&path).exists() {
         assert!(
             std::env::var("CI").as_deref() != Ok("true"),
             "real image missing under CI=true: {path}"
         );
         let _ = writeln!(
             std::io::stderr(),
-            "\n!!! SKIPPING rtl_real_image: {path} not found !!!\n"
+            "\n!!! SKIPPING rtl_real_images: {path} not found !!!\n"
         );
         return None;
     }
-    let img = image::open(path).expect("real image decodes").into_luma8();
+    let img = image::open(&path).expect("real image decodes").into_luma8();
     let (iw, ih) = (img.width() as usize, img.height() as usize);
-    assert!(iw >= w && ih >= h, "real image smaller than the crop");
+    assert!(iw >= w && ih >= h, "{path} smaller than the crop");
     let (x0, y0) = ((iw - w) / 2, (ih - h) / 2);
     let raw = img.into_raw();
     Some(
@@ -370,24 +508,43 @@ fn real_crop(w: usize, h: usize) -> Option<Vec<u8>> {
 }
 
 #[test]
-fn rtl_real_image() {
-    if !rtl_available("rtl_real_image") {
+fn rtl_real_images() {
+    if !rtl_available("rtl_real_images") {
         return;
     }
-    let (w, h) = (320usize, 200usize);
-    let Some(img) = real_crop(w, h) else { return };
-    #[cfg(rtl_sim)]
-    {
-        let mut b = sim::Bench::new();
-        let cfg = config(w as u16, h as u16, 4);
-        let run = b.frame("real image", &cfg, &img, None);
-        for k in 0..3 {
-            assert!(
-                run.counts.points[k] > 0,
-                "no point in octave {k} of the real image"
-            );
+    // ETH3D two-view "terrace" (713x434) and a EuRoC frame (752x480).
+    let cases = [
+        ("eth3d_two_view/terrace/im0.png", 640usize, 400usize, 1u8),
+        ("euroc_pairs/sf0_left.png", 752, 200, 0),
+    ];
+    for (rel, w, h, sobel_scale) in cases {
+        let Some(img) = real_crop(rel, w, h) else {
+            return;
+        };
+        #[cfg(rtl_sim)]
+        {
+            let mut b = sim::Bench::new();
+            let cfg = Config {
+                sobel_scale,
+                ..config(w as u16, h as u16, 4)
+            };
+            let run = b.frame(rel, &cfg, &img, None);
+            for k in 0..3 {
+                assert!(run.counts.points[k] > 0, "no point in octave {k} of {rel}");
+            }
+            // Posterized to 4 grey levels: wide flat areas, equal DoG samples, plateaus.
+            let (w2, h2) = (w.min(320), h.min(200));
+            let crop: Vec<u8> = (0..h2)
+                .flat_map(|y| img[y * w..y * w + w2].iter().map(|&p| (p & 0xc0) | 0x20))
+                .collect();
+            let cfg = Config {
+                contrast_threshold: 64,
+                ..config(w2 as u16, h2 as u16, 3)
+            };
+            let run = b.frame(&format!("{rel} posterized"), &cfg, &crop, None);
+            assert!(run.counts.points[0] > 0, "no point in posterized {rel}");
         }
+        #[cfg(not(rtl_sim))]
+        let _ = (img, sobel_scale);
     }
-    #[cfg(not(rtl_sim))]
-    let _ = img;
 }
