@@ -19,7 +19,6 @@ fn probe_matches_the_output_streams() {
         let img = common::random_image(w as usize, h as usize, 7 + octaves as u64);
         let mut fe = Box::new(RegisterFrontEnd::<1280, 640, 320, 160>::new());
         fe.start_frame(&cfg).unwrap();
-        assert_eq!(*fe.probe(), stereocal_firmware::fabric::ClockProbe::IDLE);
         let (mut probed_points, mut probed_sobel) = (Vec::new(), Vec::new());
         let (mut fifo_points, mut fifo_sobel) = (Vec::new(), Vec::new());
         let mut pixels = img.iter().copied();

@@ -369,11 +369,11 @@ impl<'a> Lockstep<'a> {
     fn clock(&mut self, pixel: Option<u8>) -> Result<bool, Box<Mismatch>> {
         self.pixels_in += pixel.is_some() as u64;
         self.model.clock(pixel);
+        let rust_probe = *self.model.probe();
         // The point and Sobel FIFOs of the model are not the RTL's: keep them drained.
         while self.model.pop_point().is_some() {}
         while self.model.pop_sobel().is_some() {}
         let (rtl_probe, rtl_done) = self.rtl.clock(pixel);
-        let rust_probe = self.model.probe();
         let (clock, pixels_in) = (self.clock, self.pixels_in);
         let mismatch = |octave, (signal, rust, rtl)| {
             Box::new(Mismatch {
@@ -390,7 +390,7 @@ impl<'a> Lockstep<'a> {
                 return Err(mismatch(Some(k), d));
             }
         }
-        count(&mut self.counts, rust_probe);
+        count(&mut self.counts, &rust_probe);
         let rust_done = self.model.octaves_done();
         if rust_done != rtl_done {
             let d = (

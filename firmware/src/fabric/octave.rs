@@ -159,9 +159,10 @@ impl<const W: usize> Octave<W> {
     /// One clock. `input` is a Q8.8 sample (valid strobe = `Some`). Returns the subsampler's
     /// output register: the next octave's input during this clock.
     ///
-    /// On a clock the octave is enabled it records its observation signals in `probe`
-    /// ([`crate::fabric::probe`]); otherwise `probe` is left as it is (the caller resets it).
-    pub fn clock<const W0: usize>(
+    /// With `PROBE`, on a clock the octave is enabled it records its observation signals in
+    /// `probe` ([`crate::fabric::probe`]); otherwise `probe` is left as it is (the caller
+    /// resets it). Without `PROBE` (the benchmarked path) nothing is recorded.
+    pub fn clock<const W0: usize, const PROBE: bool>(
         &mut self,
         input: Option<u16>,
         out: &mut OutputFifos<W0>,
@@ -174,7 +175,9 @@ impl<const W: usize> Octave<W> {
         if input.is_some() {
             self.taken += 1;
         }
-        probe.en = true;
+        if PROBE {
+            probe.en = true;
+        }
 
         // Gaussian cascade: every stage samples its upstream stage's output register.
         let mut g = [None; 4];
@@ -189,20 +192,22 @@ impl<const W: usize> Octave<W> {
             };
             wire = *gi;
         }
-        probe.g = g;
+        if PROBE {
+            probe.g = g;
+        }
 
         // Sobel branch.
-        probe.sobel =
-            self.cordic
-                .clock(self.gradient_reg.take())
-                .map(|(x, y, magnitude, orientation)| SobelPixel {
-                    octave: self.index,
-                    orientation,
-                    magnitude,
-                    x,
-                    y,
-                });
-        if let Some(px) = probe.sobel {
+        if let Some((x, y, magnitude, orientation)) = self.cordic.clock(self.gradient_reg.take()) {
+            let px = SobelPixel {
+                octave: self.index,
+                orientation,
+                magnitude,
+                x,
+                y,
+            };
+            if PROBE {
+                probe.sobel = Some(px);
+            }
             out.push_sobel(px);
         }
         let s = self.config.sobel_scale as usize & 3;
@@ -212,8 +217,10 @@ impl<const W: usize> Octave<W> {
         }
 
         // Detector branch, last register first.
-        probe.point = self.refine_reg.take();
-        if let Some(p) = probe.point {
+        if let Some(p) = self.refine_reg.take() {
+            if PROBE {
+                probe.point = Some(p);
+            }
             out.push_point(p);
         }
         let cfg = self.config;
@@ -235,8 +242,11 @@ impl<const W: usize> Octave<W> {
             .take()
             .filter(|(_, _, c)| passes_edge_test(&c[1], cfg.edge_ratio));
         let (w, h) = (self.width, self.height);
-        probe.dog = self.dog_reg.take();
-        self.detect_reg = self.dog_window.clock(probe.dog).and_then(|win| {
+        let dog = self.dog_reg.take();
+        if PROBE {
+            probe.dog = dog;
+        }
+        self.detect_reg = self.dog_window.clock(dog).and_then(|win| {
             let interior = win.x >= 1 && win.y >= 1 && win.x + 2 <= w && win.y + 2 <= h;
             if !interior {
                 return None;
@@ -273,7 +283,10 @@ impl<const W: usize> Octave<W> {
             }
         }
 
-        probe.sub = self.subsampler.clock(g[3]);
-        probe.sub
+        let sub = self.subsampler.clock(g[3]);
+        if PROBE {
+            probe.sub = sub;
+        }
+        sub
     }
 }

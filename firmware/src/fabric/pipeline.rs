@@ -84,13 +84,6 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
             + self.o3.align_errors()
     }
 
-    /// The observation signals of the last [`Self::clock`] (the `sc_frontend` observation
-    /// ports during that clock, [`crate::fabric::probe`]); idle before the first clock of a
-    /// frame.
-    pub fn probe(&self) -> &ClockProbe {
-        &self.probe
-    }
-
     /// Whether every configured octave has emitted everything: [`FrontEnd::frame_done`]
     /// without its input-row count (the RTL's `done` output).
     pub fn octaves_done(&self) -> bool {
@@ -102,9 +95,26 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
             && (n < 4 || self.o3.done())
     }
 
-    /// One pixel clock; `pixel = None` is a clock without a valid pixel (blanking).
+    /// The observation signals of the last [`Self::clock`]: the `sc_frontend` observation
+    /// ports during that clock ([`crate::fabric::probe`]); idle before the first clock of a
+    /// frame. The row interface ([`FrontEnd::push_row`], [`FrontEnd::blank_row`]) does not
+    /// record them (the probe reads idle after it).
+    pub fn probe(&self) -> &ClockProbe {
+        &self.probe
+    }
+
+    /// One pixel clock; `pixel = None` is a clock without a valid pixel (blanking). Records
+    /// the clock's observation signals ([`Self::probe`]).
     pub fn clock(&mut self, pixel: Option<u8>) {
-        self.probe = ClockProbe::IDLE;
+        self.step::<true>(pixel);
+    }
+
+    /// One clock; with `PROBE` its observation signals are recorded. The row interface
+    /// clocks without (the benchmarked path pays nothing for the probe).
+    fn step<const PROBE: bool>(&mut self, pixel: Option<u8>) {
+        if PROBE {
+            self.probe = ClockProbe::IDLE;
+        }
         let Some(cfg) = self.config else { return };
         let n = cfg.octaves as usize;
         let now = self.clock;
@@ -116,16 +126,16 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
         let x0 = pixel.map(|p| (p as u16) << 8);
         note(0, x0);
         let [p0, p1, p2, p3] = &mut self.probe.octaves;
-        let x1 = self.o0.clock(x0, &mut self.fifos, p0);
+        let x1 = self.o0.clock::<W0, PROBE>(x0, &mut self.fifos, p0);
         if n > 1 {
             note(1, x1);
-            let x2 = self.o1.clock(x1, &mut self.fifos, p1);
+            let x2 = self.o1.clock::<W0, PROBE>(x1, &mut self.fifos, p1);
             if n > 2 {
                 note(2, x2);
-                let x3 = self.o2.clock(x2, &mut self.fifos, p2);
+                let x3 = self.o2.clock::<W0, PROBE>(x2, &mut self.fifos, p2);
                 if n > 3 {
                     note(3, x3);
-                    self.o3.clock(x3, &mut self.fifos, p3);
+                    self.o3.clock::<W0, PROBE>(x3, &mut self.fifos, p3);
                 }
             }
         }
@@ -162,8 +172,9 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         if self.rows_in >= cfg.height {
             return Err(FrameError::TooManyRows);
         }
+        self.probe = ClockProbe::IDLE;
         for &p in row {
-            self.clock(Some(p));
+            self.step::<false>(Some(p));
         }
         self.rows_in += 1;
         Ok(())
@@ -171,8 +182,9 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
 
     fn blank_row(&mut self) -> bool {
         if let Some(cfg) = self.config {
+            self.probe = ClockProbe::IDLE;
             for _ in 0..cfg.width {
-                self.clock(None);
+                self.step::<false>(None);
             }
         }
         self.frame_done()

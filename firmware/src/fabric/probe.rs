@@ -19,7 +19,9 @@
 //! A valid strobe is `Some`. Every field of an octave that is not enabled on a clock (and of
 //! every octave beyond `Config::octaves`) is `false` / `None`.
 //!
-//! The recording costs a few stores per octave per clock; nothing is allocated.
+//! The recording costs a few stores per octave per clock, paid by `clock` only: the row
+//! interface (`push_row`, `blank_row`: the driver's and the benchmark's path) clocks without
+//! it (a const generic). Nothing is allocated.
 
 use crate::fabric::output::{Extremum, SobelPixel};
 
