@@ -124,6 +124,7 @@ fn config(w: u16, h: u16, octaves: u8) -> Config {
 #[cfg(rtl_sim)]
 mod sim {
     use super::*;
+    use stereocal_firmware::fabric::geometry::octave_dims;
     use stereocal_firmware::fabric::RegisterFrontEnd;
     use stereocal_hil::rtl::{
         back_to_back, cosim_clocks, cosim_frame, FrameRun, RtlFrontEnd, StreamCounts,
@@ -181,13 +182,27 @@ mod sim {
                         run.counts.points,
                         run.counts.sobel,
                     );
-                    // The streams every configured octave must carry on any frame.
-                    for k in 0..cfg.octaves as usize {
-                        assert!(run.counts.g3[k] > 0, "{name}: no G3 in octave {k}");
-                        assert!(run.counts.dog[k] > 0, "{name}: no DoG in octave {k}");
-                        assert!(run.counts.sobel[k] > 0, "{name}: no Sobel in octave {k}");
-                        if k + 1 < cfg.octaves as usize {
-                            assert!(run.counts.sub[k] > 0, "{name}: no subsample out of {k}");
+                    // One G3, DoG and Sobel sample per pixel of every configured octave, one
+                    // subsample per pixel of the next (both sides, as they are identical).
+                    let c = &run.counts;
+                    for k in 0..4u8 {
+                        let (w, h) = octave_dims(cfg.width, cfg.height, k);
+                        let on = k < cfg.octaves;
+                        let n = if on { w as u64 * h as u64 } else { 0 };
+                        let (w1, h1) = octave_dims(cfg.width, cfg.height, k + 1);
+                        let next = if k + 1 < cfg.octaves {
+                            w1 as u64 * h1 as u64
+                        } else {
+                            0
+                        };
+                        let k = k as usize;
+                        assert_eq!(
+                            [c.g3[k], c.dog[k], c.sobel[k]],
+                            [n; 3],
+                            "{name}: octave {k}"
+                        );
+                        if next > 0 {
+                            assert_eq!(c.sub[k], next, "{name}: subsamples of octave {k}");
                         }
                     }
                     run
