@@ -11,26 +11,13 @@
 //! records, read with `gimli`). Run: `cargo test --release -p stereocal-hil --test
 //! firmware_panic_free -- --nocapture`.
 //!
-//! `DRIVER_ALLOWLIST` is temporary: the soft-core driver (`firmware/src/driver`) is being
-//! rewritten, and until then a call into a panicking symbol is tolerated when its project
-//! source is in `firmware/src/driver` (or, with no inline record, its function is in
-//! `stereocal_firmware::driver`). Calls made by the handler's own formatting (into
-//! `rust_begin_unwind` or `PanicInfo`'s `Display`) are not entry points and are not counted.
-//! Set it to `false` once the rewrite lands: then no panicking symbol may be present at all.
+//! Calls made by the handler's own formatting (into `rust_begin_unwind` or `PanicInfo`'s
+//! `Display`) are not entry points and are not listed as callers; the test still requires that
+//! no panicking symbol is present at all.
 
 use std::collections::BTreeMap;
 
 use object::{Object, ObjectSection, ObjectSymbol, SymbolKind};
-
-/// Temporary: tolerate panicking symbols reached only from `stereocal_firmware::driver`
-/// (see the module docs).
-const DRIVER_ALLOWLIST: bool = true;
-
-/// The module path prefix of the functions the temporary allowlist covers.
-const DRIVER_PATH: &str = "stereocal_firmware::driver::";
-
-/// The source directory the temporary allowlist covers.
-const DRIVER_SOURCE: &str = "firmware/src/driver/";
 
 #[test]
 fn firmware_panic_free() {
@@ -41,13 +28,11 @@ fn firmware_panic_free() {
     let offending = report.offending();
     assert!(
         offending.is_empty(),
-        "{} links panicking paths from outside the allowlist:\n{}",
+        "{} links panicking paths:\n{}",
         elf.display(),
         offending.join("\n")
     );
-    if !DRIVER_ALLOWLIST {
-        assert!(report.panicking.is_empty(), "{}", report.summary());
-    }
+    assert!(report.panicking.is_empty(), "{}", report.summary());
 }
 
 /// One function of the ELF.
@@ -121,9 +106,9 @@ impl PanicReport {
         Self { panicking }
     }
 
-    /// Every panicking symbol reached from a function that is neither panic machinery nor,
-    /// while the allowlist stands, driver code; and every panicking symbol with no call at
-    /// all (referenced some other way, so the decoding cannot vouch for it).
+    /// Every panicking symbol reached from a function that is not panic machinery, with its
+    /// callers; and every panicking symbol with no call at all (referenced some other way, so
+    /// the decoding cannot vouch for it).
     fn offending(&self) -> Vec<String> {
         let mut out = Vec::new();
         for (symbol, calls) in &self.panicking {
@@ -134,10 +119,7 @@ impl PanicReport {
             if handler_internal(symbol) {
                 continue;
             }
-            let roots: Vec<&Call> = self
-                .roots(calls)
-                .filter(|call| !(DRIVER_ALLOWLIST && call.in_driver()))
-                .collect();
+            let roots: Vec<&Call> = self.roots(calls).collect();
             if !roots.is_empty() {
                 out.push(format!("  {symbol}, called from:"));
                 for call in roots {
@@ -176,16 +158,6 @@ impl PanicReport {
             out.push_str(&format!("\n    {call}"));
         }
         out
-    }
-}
-
-impl Call {
-    /// Whether the temporary allowlist covers this call.
-    fn in_driver(&self) -> bool {
-        match &self.source {
-            Some(source) => source.contains(DRIVER_SOURCE),
-            None => self.caller.starts_with(DRIVER_PATH),
-        }
     }
 }
 
