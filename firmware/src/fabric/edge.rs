@@ -4,8 +4,9 @@
 //!
 //! Integers only: `Dxx = c[1][2] + c[1][0] - 2c[1][1]` (and `Dyy` alike) need 18 bits; the cross
 //! difference `4·Dxy = c[2][2] - c[2][0] - c[0][2] + c[0][0]` needs 18 bits. Scaling `Dxx`, `Dyy`
-//! by 4 makes the test exact without a division: `Tr' = 4·Tr`, `Det' = 16·Det`, products fit
-//! `i64` (< 2^49). Latency: one register, [`EDGE_LATENCY`].
+//! by 4 makes the test exact without a division: `Tr' = 4·Tr`, `Det' = 16·Det`, and every
+//! product fits `i64` (`|Det'|` < 2^38, `Tr'²·r` < 2^48, `(r+1)²·|Det'|` < 2^54 for an 8-bit
+//! `r`; `rtl/sc_edge.v` uses exactly these widths). Latency: one register, [`EDGE_LATENCY`].
 
 /// Edge test register latency in enabled clocks.
 pub const EDGE_LATENCY: u32 = 1;
