@@ -203,7 +203,10 @@ fn a_short_soak_keeps_estimates_exact_and_samples_memory() {
     // for its pair (`wrong == 0`), so the bar is checked on the clean run over the six pairs
     // and the soak's worst error cannot exceed the clean worst.
     let clean = s.clean_median_deg.unwrap();
-    assert!(clean <= MEDIAN_BAR_DEG, "clean median raw error {clean}°: {s:?}");
+    assert!(
+        clean <= MEDIAN_BAR_DEG,
+        "clean median raw error {clean}°: {s:?}"
+    );
     assert!(s.max_deg <= s.clean_max_deg, "{s:?}");
     // Memory plumbing (flatness is judged on the long soak: this test shares its process
     // with the others).
