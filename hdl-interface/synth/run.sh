@@ -3,7 +3,7 @@
 # four-octave front end at 640 px, nextpnr-ice40 for Fmax where a design fits, and
 # docs/HARDWARE.md regenerated from the numbers of this run (report.py).
 #
-#   bash hdl-interface/synth/run.sh            # everything (about 15-20 min on 2 cores)
+#   bash hdl-interface/synth/run.sh            # everything (15-25 min on 2 shared cores; see the report)
 #   SYNTH_ONLY="colconv cordic" bash hdl-interface/synth/run.sh   # a subset, for development
 #
 # Environment:
@@ -195,7 +195,8 @@ for spec in "${JOBS[@]}"; do
     fi
 done
 echo "run.sh: ${#sel[@]} jobs, $PAR in parallel, logs in $OUT"
-printf '%s\0' "${sel[@]}" | xargs -0 -P "$PAR" -I{} bash -c 'do_job "$1"' _ {}
+# do_job's status is in status.tsv; exit 0 so that xargs never stops on a failed step.
+printf '%s\0' "${sel[@]}" | xargs -0 -P "$PAR" -I{} bash -c 'do_job "$1"; exit 0' _ {}
 
 T1=$(date +%s)
 echo $(( T1 - T0 )) > "$OUT/seconds"
