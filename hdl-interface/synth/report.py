@@ -347,7 +347,8 @@ def main():
       f"Tools: {yv}; {nv}. RTL: `hdl-interface/rtl/` at commit {head}"
       + (f"; not committed at run time: {dirty}" if dirty else "") + ".")
     A("")
-    A("What was synthesised: the RTL of issue #7 at 640 px line width, two designs:")
+    summary_at = len(L)
+    A("What was synthesised (issue #7), at 640 px line width:")
     A("")
     for n in ("octave0", "frontend"):
         if n in jobs:
@@ -725,7 +726,7 @@ def main():
         if 1000.0 / sn < need_buf:
             v += (f"{jobs[n]['top']} does not: a single clock stage whose logic alone takes "
                   f"{sn:.1f} ns with iCE40 HX cell delays (at most {1000.0 / sn:.1f} MHz), so on "
-                  "iCE40 fabric an octave with it cannot reach the rate even with room to spare; "
+                  "iCE40 fabric an octave containing it cannot reach the rate on any device size; "
                   "it would need several clocks per refinement (a pipelined or iterative divider), "
                   "which the clock-exact model does not have today. ")
         else:
@@ -757,6 +758,40 @@ def main():
     A("")
     A("Logs and netlists of the run are in `$SYNTH_OUT` (default `out/synth/`, not committed).")
     A("")
+
+    # ---- summary at the top ----
+    S = ["## Summary", ""]
+    for n in ("octave0", "frontend"):
+        if (n, "xc7") in mains:
+            x = mains[(n, "xc7")][0]
+            S.append(f"- {jobs[n]['top']} on Xilinx 7 Series (yosys): **{fmt(x['lut'])} LUT, "
+                     f"{fmt(x['ff'])} FF, {fmt(x['bram'])} RAMB36, {fmt(x['dsp'])} DSP48E1**; "
+                     f"smallest listed Artix-7 that holds it: {smallest(n)}.")
+    if ("octave0", "ice40") in mains:
+        x = mains[("octave0", "ice40")][0]
+        if oct_f and oct_st and oct_st[0] == "ok":
+            S.append(f"- One octave on iCE40: {fmt(x['lut'])} LUT4, {fmt(x['bram'])} SB_RAM40_4K, "
+                     f"{fmt(x['dsp'])} SB_MAC16; routed on the UP5K at **{oct_f:.1f} MHz**.")
+        else:
+            S.append(f"- One octave on iCE40: {fmt(x['lut'])} LUT4, {fmt(x['bram'])} SB_RAM40_4K, "
+                     f"{fmt(x['dsp'])} SB_MAC16: it fits neither the UP5K nor the HX8K, so no routed "
+                     "Fmax for the octave; its blocks were placed and routed one by one.")
+    if routed_min:
+        S.append("- Slowest block of the octave, each placed and routed alone: " + ", ".join(
+            f"{routed_min[d]:.1f} MHz on the {DEVICES[d][0]}" for d in routed_min)
+            + f"; 640 x 240 at 60 Hz needs {need_buf:.2f} MHz.")
+    for n, sn in slow_sta:
+        S.append(f"- {jobs[n]['top']} fits no iCE40; its single-clock logic alone is {sn:.1f} ns "
+                 f"(<= {1000.0 / sn:.1f} MHz) with iCE40 HX cell delays"
+                 + (", below the rate needed." if 1000.0 / sn < need_buf else "."))
+    if ("octave0", "xc7") in mains:
+        x = mains[("octave0", "xc7")][0]
+        S.append(f"- Beside Vitis Vision's DoG ({VITIS_DOG['lut']:,} LUT, {VITIS_DOG['ff']:,} FF, "
+                 f"{VITIS_DOG['bram']} BRAM, {VITIS_DOG['dsp']} DSP at 1080p): one octave here is "
+                 f"{fmt(x['lut'])} LUT, {fmt(x['ff'])} FF, {fmt(x['bram'])} RAMB36, {fmt(x['dsp'])} DSP. "
+                 "The thesis gives no resource figures (its device: a Virtex-II of 2M gates).")
+    S.append("")
+    L[summary_at:summary_at] = S
     open(md_path, "w").write("\n".join(L))
 
 

@@ -5,6 +5,7 @@
 #
 #   bash hdl-interface/synth/run.sh            # everything (15-25 min on 2 shared cores; see the report)
 #   SYNTH_ONLY="colconv cordic" bash hdl-interface/synth/run.sh   # a subset, for development
+#   bash hdl-interface/synth/run.sh --report-only   # docs/HARDWARE.md again from the last run's logs
 #
 # Environment:
 #   SYNTH_OUT      scratch directory for logs and netlists (default: <repo>/out/synth, ignored
@@ -27,6 +28,11 @@ SYNTH_TIMEOUT=${SYNTH_TIMEOUT:-1500}
 PNR_TIMEOUT=${PNR_TIMEOUT:-600}
 PAR=${SYNTH_JOBS:-2}
 PNR_FREQ=50   # nextpnr target (MHz); the achieved Fmax is reported whatever the target
+
+if [ "${1:-}" = --report-only ]; then
+    # Rewrite docs/HARDWARE.md from the logs of the last run in $SYNTH_OUT.
+    exec python3 "$HERE/report.py" "$OUT" "$REPO/docs/HARDWARE.md"
+fi
 
 for tool in yosys nextpnr-ice40 python3 timeout; do
     command -v "$tool" >/dev/null || { echo "run.sh: $tool not found" >&2; exit 1; }
