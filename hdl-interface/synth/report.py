@@ -357,9 +357,10 @@ def main():
     A("")
     A("Targets and why:")
     A("")
-    A("- `synth_xilinx -family xc7` (7 Series: LUT6, RAMB18E1/RAMB36E1, DSP48E1): the family "
-      "yosys 0.23 supports best (block RAM, DSP and carry mapping are not experimental), and "
-      "the one the Vitis Vision figures are for (Zynq-7000 / UltraScale class). Hierarchy kept "
+    A("- `synth_xilinx -family xc7` (7 Series: LUT6, RAMB18E1/RAMB36E1, DSP48E1): the default "
+      "family of yosys 0.23's `synth_xilinx`, not marked experimental, with block RAM, DSP and "
+      "carry mapping; LUT6, 36 kbit block RAM and DSP48 are the same kinds of resource the "
+      "Vitis Vision figures count. Hierarchy kept "
       "(the default), so the totals below break down per block. yosys gives no timing for "
       "Xilinx parts (no place and route here), so there is **no Fmax for Xilinx**.")
     A("- `synth_xilinx -family xc2v` (Virtex-II: LUT4, RAMB16, MULT18X18), the thesis' family; "
