@@ -27,10 +27,11 @@
 // Sobel pixel on the same clock. Both FIFOs take up to 4 entries per clock in octave order
 // o0, o1, o2, o3, the order in which the model's RegisterFrontEnd::clock pushes them (octave
 // k's items are pushed inside octave k's clock, octave 0 first), so the FIFO contents and the
-// overflow counts equal the model's entry for entry: each FIFO is 4 banks interleaved by slot
-// (no skid buffer, no stall; the datapath has no back-pressure, as the model). A pop on the
-// same clock as pushes frees its slot for the next clock (the model's driver pops between
-// clocks). POINT_OVERFLOW / SOBEL_OVERFLOW are set on a clock that dropped an entry.
+// overflow counts equal the model's entry for entry: each FIFO is an sc_out_fifo, 4 banks
+// interleaved by slot (no skid buffer, no stall; the datapath has no back-pressure, as the
+// model; its header has the layout). A pop on the same clock as pushes frees its slot for
+// the next clock (the model's driver pops between clocks). POINT_OVERFLOW / SOBEL_OVERFLOW
+// are set on a clock that dropped an entry.
 //
 // Reads: POINT_FIFO_DATA shows the head (VALID = level != 0; the whole word reads 0 when the
 // FIFO is empty, SCALE = 1 otherwise); its read pops the head and loads the point's DX/DY and
@@ -290,201 +291,20 @@ module sc_fabric #(
     endgenerate
 
     // ---------------------------------------------------------------------------------------
-    // Point FIFO: POINT_DEPTH (512) entries of 88 bits in 4 banks of
-    // pf_ROWS rows; slot i is bank i % 4, row i / 4. Up to 4 entries arrive per clock (one
-    // per octave): item k takes the write slot (pf_wrow, pf_wlane) + rank_k (rank_k = valid
-    // items of octaves below k), so the items of one clock land in distinct banks. With f free
-    // slots before the edge and n arrivals, the first min(n, f) in octave order are kept and
-    // the rest counted, as the model's pushes one after the other. A pop on the same edge
-    // frees its slot for the next clock.
-    localparam pf_ROWS = POINT_DEPTH / 4;
-    localparam pf_AW   = (pf_ROWS > 1) ? $clog2(pf_ROWS) : 1;   // row address bits
-    localparam pf_LW   = $clog2(POINT_DEPTH + 1);                    // level: 0..POINT_DEPTH
-    localparam [pf_LW-1:0] pf_FULL = POINT_DEPTH;
-    localparam integer      pf_LAST_I = pf_ROWS - 1;
-    localparam [pf_AW-1:0] pf_LAST = pf_LAST_I[pf_AW-1:0];
+    // The two FIFOs (sc_out_fifo: up to 4 entries per clock in octave order, one pop).
+    sc_out_fifo #(.DW(88), .DEPTH(POINT_DEPTH)) u_point_fifo (
+        .clk(clk), .clear(rst || soft_reset),
+        .in_valid(pf_v), .in_data(pf_in), .pop(point_fifo_data_pop),
+        .head(pf_head), .nonempty(pf_nonempty), .level(pf_level16),
+        .dropped(pf_dropped32), .dropping(pf_dropping)
+    );
 
-    reg  [pf_AW-1:0] pf_wrow, pf_rrow;
-    reg  [1:0]        pf_wlane, pf_rlane;
-    reg  [pf_LW-1:0] pf_level;
-    reg  [31:0]       pf_dropped;    // saturating overflow count
-
-    // Ranks within the clock, 0..3, and the slot lane each item would take.
-    wire [2:0]  pf_r1 = {2'd0, pf_v[0]};
-    wire [2:0]  pf_r2 = pf_r1 + {2'd0, pf_v[1]};
-    wire [2:0]  pf_r3 = pf_r2 + {2'd0, pf_v[2]};
-    wire [2:0]  pf_n  = pf_r3 + {2'd0, pf_v[3]};              // arrivals, 0..4
-    wire [11:0] pf_rank = {pf_r3, pf_r2, pf_r1, 3'd0};         // item k at [k*3 +: 3]
-    wire [pf_LW-1:0] pf_free = pf_FULL - pf_level;
-    wire [2:0]  pf_acc = ({{(pf_LW-3){1'b0}}, pf_n} <= pf_free) ? pf_n : pf_free[2:0];
-    wire [2:0]  pf_drop = pf_n - pf_acc;                         // 0..4
-    wire [3:0]  pf_take;                                           // item k is kept
-    wire [15:0] pf_hit;                                            // [k*4 + b]: item k -> bank b
-    genvar pf_k;
-    generate
-        for (pf_k = 0; pf_k < 4; pf_k = pf_k + 1) begin : g_pf_item
-            wire [2:0] rank = pf_rank[pf_k*3 +: 3];
-            wire [1:0] lane = pf_wlane + rank[1:0];
-            assign pf_take[pf_k] = pf_v[pf_k] && (rank < pf_acc);
-            assign pf_hit[pf_k*4 +: 4] = {4{pf_take[pf_k]}} & (4'b0001 << lane);
-        end
-    endgenerate
-
-    // Bank b < wlane is written in the next row (the slots wrap past lane 3).
-    wire [3:0]        pf_wrap = ~(4'b1111 << pf_wlane);
-    wire [pf_AW-1:0] pf_wrow_next = (pf_wrow == pf_LAST) ? {pf_AW{1'b0}} : pf_wrow + 1'b1;
-    wire [pf_AW-1:0] pf_rrow_next = (pf_rrow == pf_LAST) ? {pf_AW{1'b0}} : pf_rrow + 1'b1;
-    wire              pf_pop = point_fifo_data_pop && (pf_level != {pf_LW{1'b0}});
-    wire [1:0]        pf_rlane_n = pf_rlane + {1'b0, pf_pop};
-    wire [pf_AW-1:0] pf_rrow_n = (pf_pop && pf_rlane == 2'd3) ? pf_rrow_next : pf_rrow;
-    wire [2:0]        pf_lane_sum = {1'b0, pf_wlane} + pf_acc;
-
-    // Each bank reads the head's row every clock (the head bank's word is the FIFO head from
-    // the next clock on); a write to the row being read is passed through.
-    wire [4*88-1:0] pf_q_all;
-    genvar pf_b;
-    generate
-        for (pf_b = 0; pf_b < 4; pf_b = pf_b + 1) begin : g_pf_bank
-            reg  [88-1:0] mem [0:pf_ROWS-1];
-            reg  [88-1:0] q;
-            wire            we = pf_hit[pf_b] | pf_hit[4 + pf_b] | pf_hit[8 + pf_b]
-                               | pf_hit[12 + pf_b];
-            wire [88-1:0] wd = ({88{pf_hit[pf_b]}}      & pf_in[0*88 +: 88])
-                               | ({88{pf_hit[4 + pf_b]}}  & pf_in[1*88 +: 88])
-                               | ({88{pf_hit[8 + pf_b]}}  & pf_in[2*88 +: 88])
-                               | ({88{pf_hit[12 + pf_b]}} & pf_in[3*88 +: 88]);
-            wire [pf_AW-1:0] wa = pf_wrap[pf_b] ? pf_wrow_next : pf_wrow;
-            always @(posedge clk) begin
-                if (we) mem[wa] <= wd;
-                q <= (we && wa == pf_rrow_n) ? wd : mem[pf_rrow_n];
-            end
-            assign pf_q_all[pf_b*88 +: 88] = q;
-        end
-    endgenerate
-    assign pf_head = pf_q_all[pf_rlane*88 +: 88];
-
-    always @(posedge clk) begin
-        if (rst || soft_reset) begin
-            pf_wrow <= {pf_AW{1'b0}};
-            pf_rrow <= {pf_AW{1'b0}};
-            pf_wlane <= 2'd0;
-            pf_rlane <= 2'd0;
-            pf_level <= {pf_LW{1'b0}};
-            pf_dropped <= 32'd0;
-        end else begin
-            pf_wlane <= pf_lane_sum[1:0];
-            if (pf_lane_sum[2]) pf_wrow <= pf_wrow_next;
-            pf_rlane <= pf_rlane_n;
-            pf_rrow <= pf_rrow_n;
-            pf_level <= pf_level + {{(pf_LW-3){1'b0}}, pf_acc} - {{(pf_LW-1){1'b0}}, pf_pop};
-            if (pf_dropped > 32'hFFFF_FFFF - {29'd0, pf_drop})
-                pf_dropped <= 32'hFFFF_FFFF;
-            else
-                pf_dropped <= pf_dropped + {29'd0, pf_drop};
-        end
-    end
-    // ---------------------------------------------------------------------------------------
-    // Sobel FIFO: SOBEL_DEPTH (3 x W0) entries of 48 bits in 4 banks of
-    // sf_ROWS rows; slot i is bank i % 4, row i / 4. Up to 4 entries arrive per clock (one
-    // per octave): item k takes the write slot (sf_wrow, sf_wlane) + rank_k (rank_k = valid
-    // items of octaves below k), so the items of one clock land in distinct banks. With f free
-    // slots before the edge and n arrivals, the first min(n, f) in octave order are kept and
-    // the rest counted, as the model's pushes one after the other. A pop on the same edge
-    // frees its slot for the next clock.
-    localparam sf_ROWS = SOBEL_DEPTH / 4;
-    localparam sf_AW   = (sf_ROWS > 1) ? $clog2(sf_ROWS) : 1;   // row address bits
-    localparam sf_LW   = $clog2(SOBEL_DEPTH + 1);                    // level: 0..SOBEL_DEPTH
-    localparam [sf_LW-1:0] sf_FULL = SOBEL_DEPTH;
-    localparam integer      sf_LAST_I = sf_ROWS - 1;
-    localparam [sf_AW-1:0] sf_LAST = sf_LAST_I[sf_AW-1:0];
-
-    reg  [sf_AW-1:0] sf_wrow, sf_rrow;
-    reg  [1:0]        sf_wlane, sf_rlane;
-    reg  [sf_LW-1:0] sf_level;
-    reg  [31:0]       sf_dropped;    // saturating overflow count
-
-    // Ranks within the clock, 0..3, and the slot lane each item would take.
-    wire [2:0]  sf_r1 = {2'd0, sf_v[0]};
-    wire [2:0]  sf_r2 = sf_r1 + {2'd0, sf_v[1]};
-    wire [2:0]  sf_r3 = sf_r2 + {2'd0, sf_v[2]};
-    wire [2:0]  sf_n  = sf_r3 + {2'd0, sf_v[3]};              // arrivals, 0..4
-    wire [11:0] sf_rank = {sf_r3, sf_r2, sf_r1, 3'd0};         // item k at [k*3 +: 3]
-    wire [sf_LW-1:0] sf_free = sf_FULL - sf_level;
-    wire [2:0]  sf_acc = ({{(sf_LW-3){1'b0}}, sf_n} <= sf_free) ? sf_n : sf_free[2:0];
-    wire [2:0]  sf_drop = sf_n - sf_acc;                         // 0..4
-    wire [3:0]  sf_take;                                           // item k is kept
-    wire [15:0] sf_hit;                                            // [k*4 + b]: item k -> bank b
-    genvar sf_k;
-    generate
-        for (sf_k = 0; sf_k < 4; sf_k = sf_k + 1) begin : g_sf_item
-            wire [2:0] rank = sf_rank[sf_k*3 +: 3];
-            wire [1:0] lane = sf_wlane + rank[1:0];
-            assign sf_take[sf_k] = sf_v[sf_k] && (rank < sf_acc);
-            assign sf_hit[sf_k*4 +: 4] = {4{sf_take[sf_k]}} & (4'b0001 << lane);
-        end
-    endgenerate
-
-    // Bank b < wlane is written in the next row (the slots wrap past lane 3).
-    wire [3:0]        sf_wrap = ~(4'b1111 << sf_wlane);
-    wire [sf_AW-1:0] sf_wrow_next = (sf_wrow == sf_LAST) ? {sf_AW{1'b0}} : sf_wrow + 1'b1;
-    wire [sf_AW-1:0] sf_rrow_next = (sf_rrow == sf_LAST) ? {sf_AW{1'b0}} : sf_rrow + 1'b1;
-    wire              sf_pop = sobel_fifo_data_pop && (sf_level != {sf_LW{1'b0}});
-    wire [1:0]        sf_rlane_n = sf_rlane + {1'b0, sf_pop};
-    wire [sf_AW-1:0] sf_rrow_n = (sf_pop && sf_rlane == 2'd3) ? sf_rrow_next : sf_rrow;
-    wire [2:0]        sf_lane_sum = {1'b0, sf_wlane} + sf_acc;
-
-    // Each bank reads the head's row every clock (the head bank's word is the FIFO head from
-    // the next clock on); a write to the row being read is passed through.
-    wire [4*48-1:0] sf_q_all;
-    genvar sf_b;
-    generate
-        for (sf_b = 0; sf_b < 4; sf_b = sf_b + 1) begin : g_sf_bank
-            reg  [48-1:0] mem [0:sf_ROWS-1];
-            reg  [48-1:0] q;
-            wire            we = sf_hit[sf_b] | sf_hit[4 + sf_b] | sf_hit[8 + sf_b]
-                               | sf_hit[12 + sf_b];
-            wire [48-1:0] wd = ({48{sf_hit[sf_b]}}      & sf_in[0*48 +: 48])
-                               | ({48{sf_hit[4 + sf_b]}}  & sf_in[1*48 +: 48])
-                               | ({48{sf_hit[8 + sf_b]}}  & sf_in[2*48 +: 48])
-                               | ({48{sf_hit[12 + sf_b]}} & sf_in[3*48 +: 48]);
-            wire [sf_AW-1:0] wa = sf_wrap[sf_b] ? sf_wrow_next : sf_wrow;
-            always @(posedge clk) begin
-                if (we) mem[wa] <= wd;
-                q <= (we && wa == sf_rrow_n) ? wd : mem[sf_rrow_n];
-            end
-            assign sf_q_all[sf_b*48 +: 48] = q;
-        end
-    endgenerate
-    assign sf_head = sf_q_all[sf_rlane*48 +: 48];
-
-    always @(posedge clk) begin
-        if (rst || soft_reset) begin
-            sf_wrow <= {sf_AW{1'b0}};
-            sf_rrow <= {sf_AW{1'b0}};
-            sf_wlane <= 2'd0;
-            sf_rlane <= 2'd0;
-            sf_level <= {sf_LW{1'b0}};
-            sf_dropped <= 32'd0;
-        end else begin
-            sf_wlane <= sf_lane_sum[1:0];
-            if (sf_lane_sum[2]) sf_wrow <= sf_wrow_next;
-            sf_rlane <= sf_rlane_n;
-            sf_rrow <= sf_rrow_n;
-            sf_level <= sf_level + {{(sf_LW-3){1'b0}}, sf_acc} - {{(sf_LW-1){1'b0}}, sf_pop};
-            if (sf_dropped > 32'hFFFF_FFFF - {29'd0, sf_drop})
-                sf_dropped <= 32'hFFFF_FFFF;
-            else
-                sf_dropped <= sf_dropped + {29'd0, sf_drop};
-        end
-    end
-    assign pf_nonempty = pf_level != {pf_LW{1'b0}};
-    assign sf_nonempty = sf_level != {sf_LW{1'b0}};
-    assign pf_level16 = {{(16 - pf_LW){1'b0}}, pf_level};
-    assign sf_level16 = {{(16 - sf_LW){1'b0}}, sf_level};
-    assign pf_dropped32 = pf_dropped;
-    assign sf_dropped32 = sf_dropped;
-    assign pf_dropping = pf_drop != 3'd0;
-    assign sf_dropping = sf_drop != 3'd0;
+    sc_out_fifo #(.DW(48), .DEPTH(SOBEL_DEPTH)) u_sobel_fifo (
+        .clk(clk), .clear(rst || soft_reset),
+        .in_valid(sf_v), .in_data(sf_in), .pop(sobel_fifo_data_pop),
+        .head(sf_head), .nonempty(sf_nonempty), .level(sf_level16),
+        .dropped(sf_dropped32), .dropping(sf_dropping)
+    );
 
     // Holding registers: loaded by the read that pops word 0 (zero when the FIFO was empty).
     always @(posedge clk) begin
