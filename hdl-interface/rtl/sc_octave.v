@@ -2,9 +2,10 @@
 // Base image G0 (octave 0: the input filter, a row + column convolver; octaves >= 1: the input,
 // i.e. the previous octave's subsampled G3, unfiltered), the cascade G1..G3, alignment FIFOs
 // for G0..G2, the DoG register, the DoG window, the detector chain (detect_reg: interior test
-// and sc_extrema; edge_reg: sc_edge on the middle DoG plane; refine_reg: sc_refine, dropped
-// when not ok), the Sobel window on G[cfg_sobel_scale] with gradient_reg (sc_sobel) and
-// sc_cordic, and the subsampler feeding the next octave.
+// and sc_extrema; edge_reg: sc_edge on the middle DoG plane; sc_refine: the refinement
+// pipelined over REFINE_LATENCY = 8 clocks, its last stage the refine register, rejected
+// candidates dropped there), the Sobel window on G[cfg_sobel_scale] with gradient_reg
+// (sc_sobel) and sc_cordic, and the subsampler feeding the next octave.
 //
 // Clocking (rtl_spec.md): all stages share `en = in_valid || flushing` with
 // `flushing = taken == total && !done` (only while `active`, never on `start`). Every stage
@@ -190,7 +191,7 @@ module sc_octave #(
         end
     end
 
-    // ---- detector: DoG window -> detect_reg -> edge_reg -> refine_reg ----
+    // ---- detector: DoG window -> detect_reg -> edge_reg -> sc_refine (8 stages) ----
     wire          dw_valid, dw_done;
     wire [15:0]   dw_x, dw_y;
     wire [431:0]  dw_w;  // element (y, x) at [(y*3+x)*48 +: 48], D_s at [s*16 +: 16] in it
@@ -226,23 +227,22 @@ module sc_octave #(
     reg          edge_valid;
     reg [15:0]   edge_x, edge_y;
     reg [431:0]  edge_cube;
-    wire         ref_ok;
-    wire [15:0]  ref_dx, ref_dy, ref_ds;
-    sc_refine u_refine (.cube(edge_cube), .max_offset(cfg_max_offset),
-                        .ok(ref_ok), .dx(ref_dx), .dy(ref_dy), .ds(ref_ds));
 
-    reg          ref_valid;
-    reg [95:0]   ref_data;
+    // sc_refine: REFINE_LATENCY = 8 stages, its last one the refine register (ref_valid).
+    wire         ref_valid, ref_busy;
+    wire [15:0]  ref_x, ref_y, ref_dog, ref_dx, ref_dy, ref_ds;
+    sc_refine u_refine (
+        .clk(clk), .en(en), .start(start),
+        .in_valid(edge_valid), .in_x(edge_x), .in_y(edge_y), .cube(edge_cube),
+        .max_offset(cfg_max_offset),
+        .out_valid(ref_valid), .out_x(ref_x), .out_y(ref_y), .out_dog(ref_dog),
+        .dx(ref_dx), .dy(ref_dy), .ds(ref_ds), .busy(ref_busy));
 
     always @(posedge clk) begin
         if (start) begin
             det_valid  <= 1'b0;
             edge_valid <= 1'b0;
-            ref_valid  <= 1'b0;
         end else if (en) begin
-            ref_valid <= edge_valid && ref_ok;
-            if (edge_valid && ref_ok)
-                ref_data <= {edge_cube[13*16 +: 16], ref_ds, ref_dy, ref_dx, edge_y, edge_x};
             edge_valid <= det_valid && edge_pass;
             if (det_valid && edge_pass) begin
                 edge_x    <= det_x;
@@ -259,7 +259,7 @@ module sc_octave #(
     end
 
     assign pt_valid = en && ref_valid;
-    assign pt_data  = ref_data;
+    assign pt_data  = {ref_dog, ref_ds, ref_dy, ref_dx, ref_y, ref_x};
 
     // ---- subsampler ----
     wire sub_v, sub_done;
@@ -276,7 +276,7 @@ module sc_octave #(
     assign dog_data  = dog_d;
 
     assign done = taken == total && sub_done && sw_done && !grad_valid && cor_empty
-               && dw_done && !dog_v && !det_valid && !edge_valid && !ref_valid;
+               && dw_done && !dog_v && !det_valid && !edge_valid && !ref_busy;
 
 endmodule
 

@@ -28,7 +28,7 @@ use crate::fabric::fifo::LineFifo;
 use crate::fabric::geometry::octave_dims;
 use crate::fabric::output::{Extremum, OutputFifos, SobelPixel};
 use crate::fabric::probe::OctaveProbe;
-use crate::fabric::refine::refine;
+use crate::fabric::refine::{refine, REFINE_LATENCY};
 use crate::fabric::sobel::sobel;
 use crate::fabric::subsample::Subsampler;
 use crate::fabric::taps::GAUSS_LUTS;
@@ -36,6 +36,10 @@ use crate::fabric::window::WindowFormer;
 
 /// A candidate in the detector pipeline registers: position and its DoG cube.
 type Candidate = (u16, u16, Cube);
+
+/// Refinement stages before the refine register ([`REFINE_LATENCY`] counts the register).
+const REFINE_STAGES: usize = REFINE_LATENCY as usize - 1;
+const _: () = assert!(REFINE_STAGES >= 1);
 
 /// Register-level octave whose rows are at most `W` pixels.
 #[derive(Clone, Debug)]
@@ -57,6 +61,16 @@ pub struct Octave<const W: usize> {
     dog_window: WindowFormer<[i16; 3], W>,
     detect_reg: Option<Candidate>,
     edge_reg: Option<Candidate>,
+    /// The refinement pipeline (sc_refine.v stages 1..7) as a delay line of
+    /// [`REFINE_STAGES`] registers, kept as a ring (`refine_head` is the oldest slot, the
+    /// one that moves into `refine_reg` on the next enabled clock, then takes the new
+    /// candidate). `refine()` is computed when the candidate enters; a slot is `Some` while a
+    /// candidate is in flight, `Some(None)` when refine() rejected it: like the RTL's valid
+    /// bits, rejected candidates occupy the pipeline (and keep `done()` false) until they
+    /// reach the refine register, where they are dropped.
+    refine_pipe: [Option<Option<Extremum>>; REFINE_STAGES],
+    refine_head: usize,
+    /// The last refinement stage, the output register: a point for the point FIFO.
     refine_reg: Option<Extremum>,
     sobel_window: WindowFormer<u16, W>,
     gradient_reg: Option<(u16, u16, i32, i32)>,
@@ -95,6 +109,8 @@ impl<const W: usize> Octave<W> {
             dog_window: WindowFormer::new([0; 3]),
             detect_reg: None,
             edge_reg: None,
+            refine_pipe: [None; REFINE_STAGES],
+            refine_head: 0,
             refine_reg: None,
             sobel_window: WindowFormer::new(0),
             gradient_reg: None,
@@ -125,6 +141,8 @@ impl<const W: usize> Octave<W> {
         self.dog_window.start(w, h);
         self.detect_reg = None;
         self.edge_reg = None;
+        self.refine_pipe = [None; REFINE_STAGES];
+        self.refine_head = 0;
         self.refine_reg = None;
         self.sobel_window.start(w, h);
         self.gradient_reg = None;
@@ -153,6 +171,7 @@ impl<const W: usize> Octave<W> {
             && self.dog_reg.is_none()
             && self.detect_reg.is_none()
             && self.edge_reg.is_none()
+            && self.refine_pipe.iter().all(Option::is_none)
             && self.refine_reg.is_none()
     }
 
@@ -225,7 +244,11 @@ impl<const W: usize> Octave<W> {
         }
         let cfg = self.config;
         let index = self.index;
-        self.refine_reg = self.edge_reg.take().and_then(|(x, y, c)| {
+        // Refinement pipeline: the oldest stage moves into the refine register (dropped there
+        // when rejected) and its slot takes the edge register's candidate.
+        let head = self.refine_head;
+        self.refine_reg = self.refine_pipe[head].take().flatten();
+        self.refine_pipe[head] = self.edge_reg.take().map(|(x, y, c)| {
             refine(&c, cfg.max_offset).map(|[dx, dy, ds]| Extremum {
                 x,
                 y,
@@ -237,6 +260,7 @@ impl<const W: usize> Octave<W> {
                 dog: c[1][1][1],
             })
         });
+        self.refine_head = (head + 1) % REFINE_STAGES;
         self.edge_reg = self
             .detect_reg
             .take()

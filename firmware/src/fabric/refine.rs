@@ -6,8 +6,8 @@
 //! (`2g`: 17 bits, `4H`: 19 bits). Then `4H·o = -2·(2g)`, so
 //! `o = -2·adj(4H)·(2g) / det(4H)`, computed in `i128` and divided once with rounding to the
 //! nearest Q2.13 code (ties away from zero). In the fabric this is the one divider of the front
-//! end; extrema are rare, so it may be sequential behind a small queue — the model gives it
-//! [`REFINE_LATENCY`] and the RTL must either match or update this constant.
+//! end, pipelined over [`REFINE_LATENCY`] enabled clocks at one candidate per clock (see the
+//! constant); the octave model delays `refine()`'s result by that many registers.
 //!
 //! # Output format
 //! `dx, dy, ds` are [`Offset`] = `fixed::types::I3F13` (i16, Q2.13, 1/8192 sample, the wire's
@@ -18,8 +18,19 @@
 use crate::fabric::extrema::Cube;
 use fixed::types::I3F13;
 
-/// Refinement latency in enabled clocks.
-pub const REFINE_LATENCY: u32 = 1;
+/// Refinement latency in enabled clocks: the pipeline of `hdl-interface/rtl/sc_refine.v`,
+/// one candidate per clock.
+///
+/// 8 stages: (1) the sums `2g`, `4H`; (2) the six cofactors (20x20-bit products); (3) `det` and
+/// the three dot products (20x39 and 39x17-bit products); (4) magnitudes, rounding term,
+/// overflow test and divider steps 14..12; (5)-(7) divider steps 11..3, three per stage;
+/// (8) steps 2..0, sign and limit, the refine register. Why 8: as one clock stage the
+/// refinement was 144.7 ns of logic with iCE40 HX cell delays (≤ 6.9 MHz), the one path
+/// keeping the fabric below the 9.73 MHz that 640x240 at 60 Hz needs; split so that no stage
+/// holds more than one level of products or three of the fifteen dependent 59-bit
+/// compare/subtract steps of the restoring divider. The longest stage is now 29.6 ns of logic
+/// (yosys `sta`, same cells; stage 4), ≤ 33.8 MHz before routing.
+pub const REFINE_LATENCY: u32 = 8;
 
 /// Offset format: Q2.13 in an `i16`.
 pub type Offset = I3F13;

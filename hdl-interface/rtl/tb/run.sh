@@ -15,7 +15,9 @@
 # edge-test equality, Sobel on 0/65535 windows, CORDIC on axes, diagonals and the 19-bit
 # extremes, with random clock enables and starts). --fresh and --update build it with cargo
 # outside the repository (in $TMPDIR, root Cargo.lock copied, so only the firmware crate and
-# its dependencies are built). Record layouts: tb/tb_comb.v, tb/tb_cordic.v.
+# its dependencies are built). Record layouts: tb/tb_comb.v, tb/tb_refine.v (the refine
+# records driven through the sc_refine pipeline, compared REFINE_LATENCY clocks later),
+# tb/tb_cordic.v.
 set -eu
 
 TB=$(cd "$(dirname "$0")" && pwd)
@@ -66,12 +68,16 @@ fi
 lines() { wc -l < "$1" | tr -d ' '; }
 iverilog -g2005 -Wall -o "$TMP/comb" \
     -Ptb_comb.NX="$(lines "$VEC/extrema.hex")" -Ptb_comb.NE="$(lines "$VEC/edge.hex")" \
-    -Ptb_comb.NR="$(lines "$VEC/refine.hex")" -Ptb_comb.NS="$(lines "$VEC/sobel.hex")" \
-    "$TB/tb_comb.v" "$RTL/sc_extrema.v" "$RTL/sc_edge.v" "$RTL/sc_refine.v" "$RTL/sc_sobel.v"
+    -Ptb_comb.NS="$(lines "$VEC/sobel.hex")" \
+    "$TB/tb_comb.v" "$RTL/sc_extrema.v" "$RTL/sc_edge.v" "$RTL/sc_sobel.v"
+iverilog -g2005 -Wall -o "$TMP/refine" -Ptb_refine.N="$(lines "$VEC/refine.hex")" \
+    "$TB/tb_refine.v" "$RTL/sc_refine.v"
 iverilog -g2005 -Wall -o "$TMP/cordic" -Ptb_cordic.N="$(lines "$VEC/cordic.hex")" \
     "$TB/tb_cordic.v" "$RTL/sc_cordic.v"
 
 vvp -n "$TMP/comb" +extrema="$VEC/extrema.hex" +edge="$VEC/edge.hex" \
-    +refine="$VEC/refine.hex" +sobel="$VEC/sobel.hex" | tee "$TMP/comb.log"
+    +sobel="$VEC/sobel.hex" | tee "$TMP/comb.log"
+vvp -n "$TMP/refine" +refine="$VEC/refine.hex" | tee "$TMP/refine.log"
 vvp -n "$TMP/cordic" +cordic="$VEC/cordic.hex" | tee "$TMP/cordic.log"
-grep -qx PASS "$TMP/comb.log" && grep -qx PASS "$TMP/cordic.log"
+grep -qx PASS "$TMP/comb.log" && grep -qx PASS "$TMP/refine.log" \
+    && grep -qx PASS "$TMP/cordic.log"

@@ -1,32 +1,28 @@
-// Vector testbench of the combinational RTL-B modules (sc_extrema, sc_edge, sc_refine,
-// sc_sobel) against records generated from the Rust model (run.sh). Each record is one
-// $readmemh line, most significant field first:
+// Vector testbench of the combinational RTL-B modules (sc_extrema, sc_edge, sc_sobel; the
+// pipelined sc_refine has tb_refine.v) against records generated from the Rust model (run.sh).
+// Each record is one $readmemh line, most significant field first:
 //   extrema: {is_ext(4), threshold(16), cube(432)}
 //   edge:    {pass(4), ratio(8), d(144)}
-//   refine:  {ds(16), dy(16), dx(16), ok(4), max_offset(16), cube(432)}  (offsets checked if ok)
 //   sobel:   {sy(20), sx(20), p(144)}
-// Parameters: N (records per file); files from +extrema=, +edge=, +refine=, +sobel=.
+// Parameters: N (records per file); files from +extrema=, +edge=, +sobel=.
 `default_nettype none
 
 module tb_comb;
-    parameter NX = 1, NE = 1, NR = 1, NS = 1;
+    parameter NX = 1, NE = 1, NS = 1;
 
     reg [451:0] vx [0:NX-1];
     reg [155:0] ve [0:NE-1];
-    reg [499:0] vr [0:NR-1];
     reg [183:0] vs [0:NS-1];
 
     reg  [431:0] cube;
-    reg  [15:0]  thr, maxo;
+    reg  [15:0]  thr;
     reg  [143:0] d, p;
     reg  [7:0]   ratio;
-    wire         is_ext, pass, ok;
-    wire [15:0]  dx, dy, ds;
+    wire         is_ext, pass;
     wire signed [18:0] sx, sy;
 
     sc_extrema u_x (.cube(cube), .threshold(thr), .is_ext(is_ext));
     sc_edge    u_e (.d(d), .ratio(ratio), .pass(pass));
-    sc_refine  u_r (.cube(cube), .max_offset(maxo), .ok(ok), .dx(dx), .dy(dy), .ds(ds));
     sc_sobel   u_s (.p(p), .sx(sx), .sy(sy));
 
     reg [1023:0] fname;
@@ -62,23 +58,6 @@ module tb_comb;
                 end
             end
             $display("sc_edge: %0d vectors, %0d mismatches", NE, bad);
-            total_bad = total_bad + bad;
-        end
-
-        if ($value$plusargs("refine=%s", fname)) begin
-            $readmemh(fname, vr);
-            bad = 0;
-            for (i = 0; i < NR; i = i + 1) begin
-                {maxo, cube} = vr[i][447:0];
-                #1;
-                if (ok !== vr[i][448] || (ok && {ds, dy, dx} !== vr[i][499:452])) begin
-                    bad = bad + 1;
-                    if (bad <= 5)
-                        $display("refine %0d: got ok=%b %h %h %h want ok=%b %h", i, ok, dx, dy, ds,
-                                 vr[i][448], vr[i][499:452]);
-                end
-            end
-            $display("sc_refine: %0d vectors, %0d mismatches", NR, bad);
             total_bad = total_bad + bad;
         end
 
