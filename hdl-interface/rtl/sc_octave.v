@@ -3,7 +3,7 @@
 // i.e. the previous octave's subsampled G3, unfiltered), the cascade G1..G3, alignment FIFOs
 // for G0..G2, the DoG register, the DoG window, the detector chain (detect_reg: interior test
 // and sc_extrema; edge_reg: sc_edge on the middle DoG plane; sc_refine: the refinement
-// pipelined over REFINE_LATENCY = 8 clocks, its last stage the refine register, rejected
+// pipelined over REFINE_LATENCY = 18 clocks, its last stage the refine register, rejected
 // candidates dropped there), the Sobel window on G[cfg_sobel_scale] with gradient_reg
 // (sc_sobel) and sc_cordic, and the subsampler feeding the next octave.
 //
@@ -191,7 +191,7 @@ module sc_octave #(
         end
     end
 
-    // ---- detector: DoG window -> detect_reg -> edge_reg -> sc_refine (8 stages) ----
+    // ---- detector: DoG window -> detect_reg -> edge_reg -> sc_refine (18 stages) ----
     wire          dw_valid, dw_done;
     wire [15:0]   dw_x, dw_y;
     wire [431:0]  dw_w;  // element (y, x) at [(y*3+x)*48 +: 48], D_s at [s*16 +: 16] in it
@@ -228,7 +228,7 @@ module sc_octave #(
     reg [15:0]   edge_x, edge_y;
     reg [431:0]  edge_cube;
 
-    // sc_refine: REFINE_LATENCY = 8 stages, its last one the refine register (ref_valid).
+    // sc_refine: REFINE_LATENCY = 18 stages, its last one the refine register (ref_valid).
     wire         ref_valid, ref_busy;
     wire [15:0]  ref_x, ref_y, ref_dog, ref_dx, ref_dy, ref_ds;
     sc_refine u_refine (

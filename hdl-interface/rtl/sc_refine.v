@@ -1,23 +1,23 @@
 // sc_refine: sub-pixel / sub-scale refinement of an extremum, = refine::refine, pipelined over
-// REFINE_LATENCY = 8 enabled clocks (refine.rs) at one candidate per clock.
+// REFINE_LATENCY = 18 enabled clocks (refine.rs) at one candidate per clock.
 //
 // Stages (one register each; `en` advances all of them, `start` clears the valid bits):
-//   1  gradient and Hessian sums (2g, 4H)                  adders only
-//   2  the six cofactors of 4H                              20x20-bit products
-//   3  det(4H) and the three dot products adj(4H) (2g)      20x39 / 39x17-bit products
-//   4  |det|, |num| + |det|/2, overflow test, sign; divider steps 14..12
-//   5  divider steps 11..9
-//   6  divider steps 8..6
-//   7  divider steps 5..3
-//   8  divider steps 2..0, sign, limit: the output register (= octave.rs refine_reg)
-// Why 8: the single-clock version was 144.7 ns of logic (yosys `sta`, iCE40 HX cells), the
+//   1      gradient and Hessian sums (2g, 4H)                  adders only
+//   2      the six cofactors of 4H                              20x20-bit products
+//   3      det(4H) and the three dot products adj(4H) (2g)      20x39 / 39x17-bit products
+//   4      |det|, |num| + |det|/2, overflow test, sign; divider step 14
+//   5..17  divider steps 13..1, one per stage (SPS = 1 step per stage)
+//   18     divider step 0, sign, limit: the output register (= octave.rs refine_reg)
+// Why 18: the single-clock version was 144.7 ns of logic (yosys `sta`, iCE40 HX cells), the
 // one path keeping the octave below 9.73 MHz (640x240 at 60 Hz). Each stage above is one
-// product level or three 59-bit compare/subtract steps, so no stage holds more than one of
-// the heavy operations; the restoring divider (15 dependent 59-bit carry chains) is split three
-// steps per clock. Longest stage now (yosys `sta` after `synth_ice40 -top sc_refine`, iCE40 HX
-// cell delays, logic only): 29.6 ns, stage 4 (<= 33.8 MHz before routing), from 144.7 ns.
+// product level or one of the 15 dependent 59-bit compare/subtract steps of the restoring
+// divider (about 8 ns each), aiming at the convolvers' depth (~10 ns). Longest stage now
+// (yosys `sta` after `synth_ice40 -top sc_refine`, iCE40 HX cell delays, logic only): 13.7 ns,
+// stage 3 (det: a 20x39-bit product and the 3-term sum; stage 4 is about as long, the divider
+// stages about 9.5 ns), <= 72.9 MHz before routing; 3 divider steps per stage gave 29.6 ns.
+// The price is the divider's pipeline registers (about 380 bits per stage).
 //
-// Candidates that refine() rejects (det == 0, |o_i| > max_offset) travel through stages 1..7
+// Candidates that refine() rejects (det == 0, |o_i| > max_offset) travel through stages 1..17
 // with their valid bit set and are dropped when entering the output register: `busy` (any
 // valid bit, output register included) is what octave.rs `done()` tests (its in-flight slots
 // hold rejected candidates too). max_offset is the configuration, stable during a frame.
@@ -177,7 +177,8 @@ module sc_refine (
         if (start) v3 <= 1'b0;
     end
 
-    // ---- stages 4..8: magnitudes and the restoring divider ----
+    // ---- stages 4..18: magnitudes and the restoring divider ----
+    localparam SPS = 1;  // divider steps per stage (a register after steps k % SPS == 0, k > 0)
     // Divider state after each step, SW bits: {per offset i at [107 + i*90 +: 90]:
     // {neg, ovf, nlo[14:0], q[14:0], r[57:0]}, det_mag[57:0] at [49 +: 58], dog, y, x, valid}.
     localparam SW = 1 + 48 + 58 + 3 * 90;
@@ -187,6 +188,7 @@ module sc_refine (
     wire [3*56-1:0] dots = {dot2, dot1, dot0};
     wire [SW-1:0] prep;
     assign prep[0 +: 107] = {det_mag, dog3, y3, x3, v3};
+    wire [14:0] stv;  // valid bit of the register after step k (0 where none)
     genvar i, k;
     generate
         for (i = 0; i < 3; i = i + 1) begin : g_prep
@@ -201,7 +203,7 @@ module sc_refine (
             assign prep[107 + i*90 +: 90] = {neg, ovf, n[14:0], 15'd0, 4'd0, n[68:15]};
         end
 
-        // Step k brings down n[k]; a register after steps 12, 9, 6, 3 (stages 4..7).
+        // Step k brings down n[k]; a register after steps 14..1 (stages 4..17).
         for (k = 14; k >= 0; k = k - 1) begin : g_step
             wire [SW-1:0] si;
             wire [SW-1:0] sc;
@@ -221,20 +223,22 @@ module sc_refine (
                 wire [57:0] ro  = qb ? t[57:0] - si[49 +: 58] : t[57:0];
                 assign sc[107 + i*90 +: 90] = {st[89:73], qo, ro};
             end
-            if (k % 3 == 0 && k > 0) begin : g_reg
+            if (k % SPS == 0 && k > 0) begin : g_reg
                 reg [SW-1:0] sr;
                 always @(posedge clk) begin
                     if (en) sr <= sc;
                     if (start) sr[0] <= 1'b0;
                 end
                 assign so = sr;
+                assign stv[k] = sr[0];
             end else begin : g_comb
                 assign so = sc;
+                assign stv[k] = 1'b0;
             end
         end
     endgenerate
 
-    // ---- stage 8 tail: sign, limit, the output register ----
+    // ---- stage 18 tail: sign, limit, the output register ----
     // The remainders after step 0 are not needed.
     /* verilator lint_off UNUSEDSIGNAL */
     wire [SW-1:0] fin = g_step[0].so;
@@ -266,8 +270,7 @@ module sc_refine (
         if (start) out_valid <= 1'b0;
     end
 
-    assign busy = v1 || v2 || v3 || g_step[12].so[0] || g_step[9].so[0] || g_step[6].so[0]
-               || g_step[3].so[0] || out_valid;
+    assign busy = v1 || v2 || v3 || stv != 15'd0 || out_valid;
 endmodule
 
 `default_nettype wire

@@ -61,7 +61,7 @@ pub struct Octave<const W: usize> {
     dog_window: WindowFormer<[i16; 3], W>,
     detect_reg: Option<Candidate>,
     edge_reg: Option<Candidate>,
-    /// The refinement pipeline (sc_refine.v stages 1..7) as a delay line of
+    /// The refinement pipeline (sc_refine.v stages 1..17) as a delay line of
     /// [`REFINE_STAGES`] registers, kept as a ring (`refine_head` is the oldest slot, the
     /// one that moves into `refine_reg` on the next enabled clock, then takes the new
     /// candidate). `refine()` is computed when the candidate enters; a slot is `Some` while a

@@ -21,16 +21,16 @@ use fixed::types::I3F13;
 /// Refinement latency in enabled clocks: the pipeline of `hdl-interface/rtl/sc_refine.v`,
 /// one candidate per clock.
 ///
-/// 8 stages: (1) the sums `2g`, `4H`; (2) the six cofactors (20x20-bit products); (3) `det` and
-/// the three dot products (20x39 and 39x17-bit products); (4) magnitudes, rounding term,
-/// overflow test and divider steps 14..12; (5)-(7) divider steps 11..3, three per stage;
-/// (8) steps 2..0, sign and limit, the refine register. Why 8: as one clock stage the
-/// refinement was 144.7 ns of logic with iCE40 HX cell delays (≤ 6.9 MHz), the one path
-/// keeping the fabric below the 9.73 MHz that 640x240 at 60 Hz needs; split so that no stage
-/// holds more than one level of products or three of the fifteen dependent 59-bit
-/// compare/subtract steps of the restoring divider. The longest stage is now 29.6 ns of logic
-/// (yosys `sta`, same cells; stage 4), ≤ 33.8 MHz before routing.
-pub const REFINE_LATENCY: u32 = 8;
+/// 18 stages: (1) the sums `2g`, `4H`; (2) the six cofactors (20x20-bit products); (3) `det`
+/// and the three dot products (20x39 and 39x17-bit products); (4) magnitudes, rounding term,
+/// overflow test and divider step 14; (5)-(17) divider steps 13..1, one per stage; (18) step 0,
+/// sign and limit, the refine register. Why 18: as one clock stage the refinement was
+/// 144.7 ns of logic with iCE40 HX cell delays (≤ 6.9 MHz), the one path keeping the fabric
+/// below the 9.73 MHz that 640x240 at 60 Hz needs; split so that no stage holds more than one
+/// level of products or one of the fifteen dependent 59-bit compare/subtract steps of the
+/// restoring divider (about 8 ns each), near the convolvers' depth. The longest stage is now
+/// 13.7 ns of logic (yosys `sta`, same cells; stage 3), ≤ 72.9 MHz before routing.
+pub const REFINE_LATENCY: u32 = 18;
 
 /// Offset format: Q2.13 in an `i16`.
 pub type Offset = I3F13;

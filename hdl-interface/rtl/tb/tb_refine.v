@@ -13,7 +13,7 @@
 `default_nettype none
 
 module tb_refine;
-    parameter N = 1, L = 8;
+    parameter N = 1, L = 18;
 
     reg [499:0] vr [0:N-1];
 
