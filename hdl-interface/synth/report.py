@@ -695,7 +695,7 @@ def main():
                     f"{1000.0 / (sn * lo):.1f} MHz (an extrapolation, not a measurement)")
         bound = 1000.0 / sn
         if bound < need_buf:
-            txt += (f". As a single-clock stage of the octave it alone keeps the octave below the "
+            txt += (f". Its slowest stage alone keeps the octave below the "
                     f"{need_buf:.2f} MHz buffered rate on iCE40 HX fabric, before any routing")
         else:
             worst_all = [fmax_of[(m, "hx8k")] for m in blocks if fmax_of.get((m, "hx8k"))]
@@ -725,13 +725,13 @@ def main():
               + "). ")
     for n, sn in slow_sta:
         if 1000.0 / sn < need_buf:
-            v += (f"{jobs[n]['top']} does not: a single clock stage whose logic alone takes "
+            v += (f"{jobs[n]['top']} does not: its slowest register-to-register path alone takes "
                   f"{sn:.1f} ns with iCE40 HX cell delays (at most {1000.0 / sn:.1f} MHz), so on "
-                  "iCE40 fabric an octave containing it cannot reach the rate on any device size; "
-                  "it would need several clocks per refinement (a pipelined or iterative divider), "
-                  "which the clock-exact model does not have today. ")
+                  "iCE40 fabric an octave containing it cannot reach the rate on any device size "
+                  "without a deeper pipeline. ")
         else:
-            v += (f"{jobs[n]['top']} routed nowhere; its logic-only bound is {1000.0 / sn:.1f} MHz. ")
+            v += (f"{jobs[n]['top']} routed nowhere (too large for an iCE40); its slowest stage's "
+                  f"logic-only bound is {1000.0 / sn:.1f} MHz, above the rate. ")
     def smallest(n):
         if (n, "xc7") not in mains:
             return None
@@ -782,7 +782,7 @@ def main():
             f"{routed_min[d]:.1f} MHz on the {DEVICES[d][0]}" for d in routed_min)
             + f"; 640 x 240 at 60 Hz needs {need_buf:.2f} MHz.")
     for n, sn in slow_sta:
-        S.append(f"- {jobs[n]['top']} fits no iCE40; its single-clock logic alone is {sn:.1f} ns "
+        S.append(f"- {jobs[n]['top']} fits no iCE40; its slowest stage's logic alone is {sn:.1f} ns "
                  f"(<= {1000.0 / sn:.1f} MHz) with iCE40 HX cell delays"
                  + (", below the rate needed." if 1000.0 / sn < need_buf else "."))
     if ("octave0", "xc7") in mains:
