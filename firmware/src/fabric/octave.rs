@@ -246,7 +246,9 @@ impl<const W: usize> Octave<W> {
         let index = self.index;
         // Refinement pipeline: the oldest stage moves into the refine register (dropped there
         // when rejected) and its slot takes the edge register's candidate.
-        let head = self.refine_head;
+        // `refine_head` is always reduced; reducing again lets the compiler see the index in
+        // range (no bounds check, so no panic path in the firmware).
+        let head = self.refine_head % REFINE_STAGES;
         self.refine_reg = self.refine_pipe[head].take().flatten();
         self.refine_pipe[head] = self.edge_reg.take().map(|(x, y, c)| {
             refine(&c, cfg.max_offset).map(|[dx, dy, ds]| Extremum {
