@@ -1,5 +1,5 @@
-//! Row and column stages: golden vectors and a property test against a direct separable
-//! convolution with the same quantized taps and the same rounding after each pass.
+//! Row and column stages: golden vectors and a property test against a direct 2-D convolution
+//! with the outer product of the same quantized taps, rounded once.
 
 use proptest::prelude::*;
 use stereocal_firmware::fabric::convolver::{ColumnConvolver, RowConvolver};
@@ -26,29 +26,28 @@ fn stages(img: &[u16], w: u16, h: u16, k: usize) -> Vec<u16> {
     out
 }
 
-/// Plain reference: separable, replicated border, round after each pass.
+/// Plain reference: a direct 2-D convolution with the 5x5 kernel `t[i]·t[j]` (Q0.20), replicated
+/// border, rounded once (half up).
 fn reference(img: &[u16], w: usize, h: usize, k: usize) -> Vec<u16> {
     let t = GAUSS_TAPS[k];
-    let pass = |get: &dyn Fn(isize) -> u16| -> u16 {
-        let s: u32 = (0..5)
-            .map(|j| t[j] as u32 * get(j as isize - 2) as u32)
-            .sum();
-        ((s + 512) >> 10) as u16
+    let at = |x: isize, y: isize| {
+        let (x, y) = (x.clamp(0, w as isize - 1), y.clamp(0, h as isize - 1));
+        img[y as usize * w + x as usize] as u64
     };
-    let mut r = vec![0u16; w * h];
+    let mut out = vec![0u16; w * h];
     for y in 0..h {
         for x in 0..w {
-            r[y * w + x] =
-                pass(&|d| img[y * w + (x as isize + d).clamp(0, w as isize - 1) as usize]);
+            let mut s = 0u64;
+            for (i, &ti) in t.iter().enumerate() {
+                for (j, &tj) in t.iter().enumerate() {
+                    let v = at(x as isize + j as isize - 2, y as isize + i as isize - 2);
+                    s += ti as u64 * tj as u64 * v;
+                }
+            }
+            out[y * w + x] = ((s + (1 << 19)) >> 20) as u16;
         }
     }
-    let mut c = vec![0u16; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            c[y * w + x] = pass(&|d| r[(y as isize + d).clamp(0, h as isize - 1) as usize * w + x]);
-        }
-    }
-    c
+    out
 }
 
 #[test]
@@ -61,7 +60,7 @@ fn flat_image_stays_flat() {
 #[test]
 fn impulse_gives_the_outer_product_of_the_taps() {
     // A single 255.0 pixel in the middle of a 9x9 black image: output (x, y) is
-    // round(round(255·256·t[x-2] / 1024) · t[y-2] / 1024), zero outside the 5x5 support.
+    // round(255·256·t[x-2]·t[y-2] / 2^20), zero outside the 5x5 support.
     let mut img = vec![0u16; 81];
     img[4 * 9 + 4] = 255 << 8;
     let out = stages(&img, 9, 9, 1);
@@ -70,16 +69,16 @@ fn impulse_gives_the_outer_product_of_the_taps() {
         for x in 0..9 {
             let (dx, dy) = (x as isize - 4, y as isize - 4);
             let expect = if dx.abs() <= 2 && dy.abs() <= 2 {
-                let r = ((255u32 << 8) * t[(dx + 2) as usize] as u32 + 512) >> 10;
-                ((r * t[(dy + 2) as usize] as u32 + 512) >> 10) as u16
+                let p = (255u64 << 8) * t[(dx + 2) as usize] as u64 * t[(dy + 2) as usize] as u64;
+                ((p + (1 << 19)) >> 20) as u16
             } else {
                 0
             };
             assert_eq!(out[y * 9 + x], expect, "({x}, {y})");
         }
     }
-    // Centre by hand for G1 (taps 18 229 530 229 18): 65280·530/1024 = 33787.5 -> 33788,
-    // then 33788·530/1024 = 17487.8 -> 17488.
+    // Centre by hand for G1 (taps 18 229 530 229 18): 65280·530·530 / 2^20 = 17487.75 -> 17488.
+    // (Rounding after each pass would give the same here: 33787.5 -> 33788, then 17487.8.)
     assert_eq!(out[40], 17488);
 }
 
@@ -104,7 +103,7 @@ fn border_is_replicated() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     #[test]
-    fn stages_equal_direct_separable_convolution(
+    fn stages_equal_a_direct_2d_convolution(
         w in 1u16..40, h in 1u16..24, k in 0usize..4, seed in any::<u64>()
     ) {
         let n = w as usize * h as usize;

@@ -2,7 +2,7 @@
 //! and the LUT distributed arithmetic equal to the dot product.
 
 use proptest::prelude::*;
-use stereocal_firmware::fabric::convolver::da_dot;
+use stereocal_firmware::fabric::convolver::{da_column, da_row};
 use stereocal_firmware::fabric::taps::{da_lut, discrete_sigma, GAUSS_LUTS, GAUSS_TAPS, TAP_BITS};
 
 #[test]
@@ -53,11 +53,20 @@ fn lut_golden_entries() {
 
 proptest! {
     #[test]
-    fn distributed_arithmetic_equals_the_dot_product(s in prop::array::uniform5(any::<u16>()), k in 0usize..4) {
+    fn row_distributed_arithmetic_is_the_exact_dot_product(s in prop::array::uniform5(any::<u16>()), k in 0usize..4) {
         let t = GAUSS_TAPS[k];
         let dot: u32 = t.iter().zip(s).map(|(&t, s)| t as u32 * s as u32).sum();
-        let expect = ((dot + 512) >> 10) as u16;
-        prop_assert_eq!(da_dot(&GAUSS_LUTS[k], s), expect);
-        prop_assert!(expect <= *s.iter().max().unwrap());
+        prop_assert_eq!(da_row(&GAUSS_LUTS[k], s), dot);
+        prop_assert!(dot < 1 << 26);
+    }
+
+    #[test]
+    fn column_distributed_arithmetic_rounds_the_dot_product_once(s in prop::array::uniform5(0u32..1 << 26), k in 0usize..4) {
+        let t = GAUSS_TAPS[k];
+        let dot: u64 = t.iter().zip(s).map(|(&t, s)| t as u64 * s as u64).sum();
+        let expect = (dot + (1 << 19)) >> 20;
+        prop_assert_eq!(u64::from(da_column(&GAUSS_LUTS[k], s)), expect);
+        // Unity DC gain: never above the largest input, so Q8.8 inputs give a Q8.8 output.
+        prop_assert!(expect <= (*s.iter().max().unwrap() as u64 + 512) >> 10);
     }
 }

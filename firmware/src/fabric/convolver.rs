@@ -1,10 +1,16 @@
 //! 5-tap separable Gaussian convolver: a row stage then a column stage, both computing the dot
 //! product by LUT distributed arithmetic (no multiplier on the pixel path).
 //!
-//! # Widths
+//! # Widths, and one rounding
 //! Input and output are scale-image pixels, `u16` in Q8.8 (grey level with 8 fractional bits).
-//! The DA accumulator is 26 bits (`65535 · 1024 < 2^26`); the output is
-//! `(acc + 512) >> 10`, which never exceeds the largest input (unity DC gain), so it fits 16 bits.
+//! The row stage does not round: its output is the exact sum `Σ tap·sample`, 26 bits
+//! ([`ROW_BITS`]; `65535 · 1024 < 2^26`, Q8.18), and the column stage's line memories hold
+//! those 26 bits. The column stage rounds once, `(Σ tap·row + 2^19) >> 20` (round half up,
+//! 36-bit accumulator), so the separable pair computes exactly the direct 2-D convolution with
+//! the outer product of the quantized taps: `tests/convolver.rs` checks that against a plain
+//! 2-D loop. Rounding after the row pass as well would save 10 bits per line-memory word
+//! (16 instead of 26) but makes the result depend on the pass order by up to one code.
+//! The output never exceeds the largest input (unity DC gain), so it fits 16 bits.
 //!
 //! # Border
 //! Replicated: a tap that falls outside the frame reads the nearest edge pixel. The row stage
@@ -27,6 +33,12 @@ use crate::fabric::taps::TAP_BITS;
 /// Row stage latency in enabled clocks.
 pub const ROW_LATENCY: u32 = 3;
 
+/// Bits of a row-stage output (an unrounded Q8.8 x Q0.10 dot product).
+pub const ROW_BITS: u32 = 16 + TAP_BITS;
+
+/// Right shift of the column stage: both passes' tap fractions.
+pub const COLUMN_SHIFT: u32 = 2 * TAP_BITS;
+
 /// Column stage latency in enabled clocks for a `width`-pixel row.
 pub const fn column_latency(width: u16) -> u32 {
     2 * width as u32 + 1
@@ -37,21 +49,36 @@ pub const fn gaussian_latency(width: u16) -> u32 {
     ROW_LATENCY + column_latency(width)
 }
 
-/// Distributed-arithmetic dot product of 5 Q8.8 samples with the kernel whose DA table is `lut`:
-/// for every bit plane `b` the 5 sample bits address the table and the partial products are
-/// added with a shift of `b`. Then rounded back to Q8.8.
+/// Distributed-arithmetic dot product of 5 samples of `planes` bits with the kernel whose DA
+/// table is `lut`: for every bit plane `b` the 5 sample bits address the table and the partial
+/// products are added with a shift of `b`. Exact (no rounding).
 #[inline]
-pub fn da_dot(lut: &[u16; 32], s: [u16; 5]) -> u16 {
-    let mut acc: u32 = 0;
-    for b in 0..16 {
+fn da_sum(lut: &[u16; 32], s: [u32; 5], planes: u32) -> u64 {
+    let mut acc: u64 = 0;
+    for b in 0..planes {
         let mut addr = 0usize;
         for (j, &v) in s.iter().enumerate() {
             addr |= (((v >> b) & 1) as usize) << j;
         }
         // `addr` has 5 bits (one per sample), so the mask is a no-op that rules out a panic.
-        acc += (lut[addr & 31] as u32) << b;
+        acc += u64::from(lut[addr & 31]) << b;
     }
-    ((acc + (1 << (TAP_BITS - 1))) >> TAP_BITS) as u16
+    acc
+}
+
+/// The row stage's dot product of 5 Q8.8 samples: the exact [`ROW_BITS`]-bit sum.
+#[inline]
+pub fn da_row(lut: &[u16; 32], s: [u16; 5]) -> u32 {
+    // At most 1024 · 65535 < 2^26: the cast keeps every bit.
+    da_sum(lut, s.map(u32::from), 16) as u32
+}
+
+/// The column stage's dot product of 5 row-stage outputs, rounded once to Q8.8.
+#[inline]
+pub fn da_column(lut: &[u16; 32], s: [u32; 5]) -> u16 {
+    let acc = da_sum(lut, s, ROW_BITS);
+    // Unity DC gain: the rounded value is at most the largest Q8.8 input, so it fits 16 bits.
+    ((acc + (1 << (COLUMN_SHIFT - 1))) >> COLUMN_SHIFT) as u16
 }
 
 /// Horizontal 5-tap stage.
@@ -67,7 +94,7 @@ pub struct RowConvolver {
     /// Position of the next output (centre) pixel.
     centre: Raster,
     emitted: u32,
-    out: Option<u16>,
+    out: Option<u32>,
 }
 
 impl RowConvolver {
@@ -95,8 +122,8 @@ impl RowConvolver {
     }
 
     /// One enabled clock. Returns the output register (the value on the stage's output wire
-    /// during this clock), then latches the new one.
-    pub fn clock(&mut self, input: Option<u16>) -> Option<u16> {
+    /// during this clock, [`ROW_BITS`] wide), then latches the new one.
+    pub fn clock(&mut self, input: Option<u16>) -> Option<u32> {
         let out = self.out.take();
         let sample = match input {
             Some(v) => v,
@@ -122,7 +149,7 @@ impl RowConvolver {
                 // a panic path.
                 *w = self.shift[((2 - (col - xc)) as usize).min(4)];
             }
-            self.out = Some(da_dot(&self.lut, win));
+            self.out = Some(da_row(&self.lut, win));
             self.centre.advance(self.width);
             self.emitted += 1;
         }
@@ -137,7 +164,7 @@ pub struct ColumnConvolver<const W: usize> {
     width: u16,
     height: u16,
     total: u32,
-    lines: LineBuffer<u16, W, 4>,
+    lines: LineBuffer<u32, W, 4>,
     pos: Raster,
     taken: u32,
     emitted: u32,
@@ -172,8 +199,8 @@ impl<const W: usize> ColumnConvolver<W> {
         self.out = None;
     }
 
-    /// One enabled clock (see [`RowConvolver::clock`]).
-    pub fn clock(&mut self, input: Option<u16>) -> Option<u16> {
+    /// One enabled clock (see [`RowConvolver::clock`]): takes a row-stage output.
+    pub fn clock(&mut self, input: Option<u32>) -> Option<u16> {
         let out = self.out.take();
         let sample = match input {
             Some(v) => v,
@@ -193,13 +220,13 @@ impl<const W: usize> ColumnConvolver<W> {
         if self.pos.y >= 2 && self.emitted < self.total {
             let yc = self.pos.y as i32 - 2;
             let last = self.height as i32 - 1;
-            let mut win = [0u16; 5];
+            let mut win = [0u32; 5];
             for (k, w) in win.iter_mut().enumerate() {
                 let row = clamp_index(yc + k as i32 - 2, last);
                 // `row` is within y-4..=y, so the index is 0..=4 (`min` as above).
                 *w = col[((self.pos.y as i32 - row) as usize).min(4)];
             }
-            self.out = Some(da_dot(&self.lut, win));
+            self.out = Some(da_column(&self.lut, win));
             self.emitted += 1;
         }
         self.taken += 1;

@@ -192,7 +192,7 @@ mod counted {
         }
         let w = width;
         let mut input = [0u16; MAX_WIDTH];
-        let mut ring = [[0u16; MAX_WIDTH]; 5];
+        let mut ring = [[0u32; MAX_WIDTH]; 5];
         let mut scales = [[0u16; MAX_WIDTH]; 4];
         let mut dog = [0i16; MAX_WIDTH];
         let (mut sx, mut sy) = ([0i32; MAX_WIDTH], [0i32; MAX_WIDTH]);

@@ -148,16 +148,23 @@ pub fn gaussian_f64(image: &Plane<f64>, kernel: &[f64]) -> Plane<f64> {
         .rows_transposed(kernel.len(), dot)
 }
 
-/// One separable Gaussian in the fabric's arithmetic: Q8.8 samples, `TAP_BITS`-bit taps,
-/// `(Σ tap·sample + half) >> TAP_BITS` after each 1-D pass (`fabric::convolver::da_dot`).
+/// One separable Gaussian in the fabric's arithmetic: Q8.8 samples, `TAP_BITS`-bit taps, the
+/// row pass exact and the column pass rounded once, `(Σ tap·row + half) >> 2·TAP_BITS`
+/// (`fabric::convolver::da_row` / `da_column`).
 pub fn gaussian_q88(image: &Plane<u16>, taps: &[u32]) -> Plane<u16> {
-    let dot = |s: &[u16]| {
-        let acc: u32 = s.iter().zip(taps).map(|(&a, &t)| u32::from(a) * t).sum();
-        ((acc + (1 << (TAP_BITS - 1))) >> TAP_BITS) as u16
+    let row = |s: &[u16]| -> u64 {
+        s.iter()
+            .zip(taps)
+            .map(|(&a, &t)| u64::from(a) * u64::from(t))
+            .sum()
+    };
+    let column = |s: &[u64]| {
+        let acc: u64 = s.iter().zip(taps).map(|(&a, &t)| a * u64::from(t)).sum();
+        ((acc + (1 << (2 * TAP_BITS - 1))) >> (2 * TAP_BITS)) as u16
     };
     image
-        .rows_transposed(taps.len(), dot)
-        .rows_transposed(taps.len(), dot)
+        .rows_transposed(taps.len(), row)
+        .rows_transposed(taps.len(), column)
 }
 
 /// Each stage's output of the cascade `kernels` (G0 first) in grey levels.
@@ -561,7 +568,7 @@ fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stereocal_firmware::fabric::convolver::da_dot;
+    use stereocal_firmware::fabric::convolver::{da_column, da_row};
     use stereocal_firmware::fabric::taps::GAUSS_LUTS;
 
     #[test]
@@ -600,7 +607,7 @@ mod tests {
     }
 
     #[test]
-    fn q88_pass_is_the_fabric_da_dot() {
+    fn q88_gaussian_is_the_fabric_da_passes() {
         let image = Plane {
             width: 9,
             height: 7,
@@ -608,12 +615,10 @@ mod tests {
         };
         for (taps, lut) in GAUSS_TAPS.iter().zip(&GAUSS_LUTS) {
             let wide: Vec<u32> = taps.iter().map(|&t| u32::from(t)).collect();
-            let rows = image.rows_transposed(5, |s| {
-                let acc: u32 = s.iter().zip(&wide).map(|(&a, &t)| u32::from(a) * t).sum();
-                ((acc + (1 << (TAP_BITS - 1))) >> TAP_BITS) as u16
-            });
-            let da = image.rows_transposed(5, |s| da_dot(lut, [s[0], s[1], s[2], s[3], s[4]]));
-            assert_eq!(rows, da);
+            let da = image
+                .rows_transposed(5, |s| da_row(lut, [s[0], s[1], s[2], s[3], s[4]]))
+                .rows_transposed(5, |s| da_column(lut, [s[0], s[1], s[2], s[3], s[4]]));
+            assert_eq!(gaussian_q88(&image, &wide), da);
         }
     }
 

@@ -9,7 +9,8 @@ use crate::fabric::cordic::{CordicState, ATAN_BAM16};
 use crate::fabric::dog::dog;
 use crate::fabric::taps::{Taps, TAP_BITS};
 
-const ROUND: u32 = 1 << (TAP_BITS - 1);
+/// Low bits of a row-stage output in the column pass's split (see [`column_dot`]).
+const SPLIT: u32 = 13;
 
 /// `i` clamped to `0..=last` (replicated border); `min`/`max` rather than `clamp`, which
 /// asserts its bounds.
@@ -24,17 +25,34 @@ fn at_clamped(r: &[u16], i: isize, last: usize) -> u16 {
     r.get(clamp(i, last)).copied().unwrap_or(0)
 }
 
-/// Five 16x16-bit products widened to 32 bits (the form SSE2 multiplies with
-/// `pmullw`/`pmulhuw`), summed and rounded exactly like the DA stage.
+/// The row stage's exact sum: five 16x16-bit products widened to 32 bits (the form SSE2
+/// multiplies with `pmullw`/`pmulhuw`), equal to [`crate::fabric::convolver::da_row`].
 #[inline(always)]
-fn dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u16 {
+fn row_dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u32 {
     let m = |t: u16, v: u16| t as u32 * v as u32;
-    let s = m(t[0], a) + m(t[1], b) + m(t[2], c) + m(t[3], d) + m(t[4], e);
-    ((s + ROUND) >> TAP_BITS) as u16
+    m(t[0], a) + m(t[1], b) + m(t[2], c) + m(t[3], d) + m(t[4], e)
 }
 
-/// Horizontal 5-tap filter of `src` into `dst` (same length), replicated border.
-pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
+/// The column stage's once-rounded result `(Σ t·v + 2^19) >> 20` of five 26-bit row sums, in
+/// 32-bit lanes: with `v = hi·2^13 + lo`, `A = Σ t·hi` and `B = Σ t·lo` are both below 2^23,
+/// and `⌊(A·2^13 + B + 2^19) / 2^20⌋ = ⌊(A + ⌊(B + 2^19) / 2^13⌋) / 2^7⌋` (A is an integer),
+/// so no 36-bit accumulator is needed. Equal to [`crate::fabric::convolver::da_column`].
+#[inline(always)]
+fn column_dot(t: &Taps, v: [u32; 5]) -> u16 {
+    let lo_mask = (1u32 << SPLIT) - 1;
+    let mut hi = 0u32;
+    let mut lo = 0u32;
+    for (&t, v) in t.iter().zip(v) {
+        hi += t as u32 * (v >> SPLIT);
+        lo += t as u32 * (v & lo_mask);
+    }
+    let half = 1u32 << (2 * TAP_BITS - 1);
+    ((hi + ((lo + half) >> SPLIT)) >> (2 * TAP_BITS - SPLIT)) as u16
+}
+
+/// Horizontal 5-tap filter of `src` into `dst` (same length), replicated border: the exact
+/// (unrounded) row sums the column pass takes.
+pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u32]) {
     let w = src.len().min(dst.len());
     let (src, dst) = (&src[..w], &mut dst[..w]);
     if w == 0 {
@@ -43,7 +61,7 @@ pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
     let last = w - 1;
     let border = |x: usize| {
         let at = |k: isize| at_clamped(src, x as isize + k, last);
-        dot(t, at(-2), at(-1), at(0), at(1), at(2))
+        row_dot(t, at(-2), at(-1), at(0), at(1), at(2))
     };
     if w >= 5 {
         let n = w - 4;
@@ -56,7 +74,7 @@ pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
         );
         let d = &mut dst[2..n + 2];
         for i in 0..n {
-            d[i] = dot(t, s0[i], s1[i], s2[i], s3[i], s4[i]);
+            d[i] = row_dot(t, s0[i], s1[i], s2[i], s3[i], s4[i]);
         }
         for x in [0, 1, w - 2, w - 1] {
             if let Some(d) = dst.get_mut(x) {
@@ -70,8 +88,9 @@ pub fn row_filter(t: &Taps, src: &[u16], dst: &mut [u16]) {
     }
 }
 
-/// Vertical 5-tap filter: `rows` are the input rows `y-2 ..= y+2` (already border-clamped).
-pub fn column_filter(t: &Taps, rows: [&[u16]; 5], dst: &mut [u16]) {
+/// Vertical 5-tap filter: `rows` are the row sums of input rows `y-2 ..= y+2` (already
+/// border-clamped); rounds once to Q8.8.
+pub fn column_filter(t: &Taps, rows: [&[u32]; 5], dst: &mut [u16]) {
     let n = rows.iter().fold(dst.len(), |n, r| n.min(r.len()));
     let dst = &mut dst[..n];
     let (r0, r1, r2, r3, r4) = (
@@ -82,7 +101,7 @@ pub fn column_filter(t: &Taps, rows: [&[u16]; 5], dst: &mut [u16]) {
         &rows[4][..n],
     );
     for i in 0..n {
-        dst[i] = dot(t, r0[i], r1[i], r2[i], r3[i], r4[i]);
+        dst[i] = column_dot(t, [r0[i], r1[i], r2[i], r3[i], r4[i]]);
     }
 }
 
@@ -185,5 +204,40 @@ pub(crate) fn fold_select(sx: i32, sy: i32) -> CordicState {
         }
     } else {
         CordicState { x, y, z }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fabric::convolver::{da_column, da_row, ROW_BITS};
+    use crate::fabric::taps::{GAUSS_LUTS, GAUSS_TAPS};
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The 32-bit split of the column pass equals the 36-bit DA accumulator, including
+        /// the largest row sums and the rounding ties.
+        #[test]
+        fn column_split_equals_the_da_column(
+            v in prop::array::uniform5(prop_oneof![
+                0u32..1 << ROW_BITS,
+                Just((1u32 << ROW_BITS) - 1),
+                (0u32..1 << 6).prop_map(|k| k << 14),
+            ]),
+            k in 0usize..4,
+        ) {
+            let t = &GAUSS_TAPS[k];
+            let rows = v.map(|v| [v]);
+            let mut out = [0u16];
+            column_filter(t, [&rows[0], &rows[1], &rows[2], &rows[3], &rows[4]], &mut out);
+            prop_assert_eq!(out[0], da_column(&GAUSS_LUTS[k], v));
+        }
+
+        #[test]
+        fn row_filter_equals_the_da_row(s in prop::array::uniform5(any::<u16>()), k in 0usize..4) {
+            let mut out = [0u32; 5];
+            row_filter(&GAUSS_TAPS[k], &s, &mut out);
+            prop_assert_eq!(out[2], da_row(&GAUSS_LUTS[k], s));
+        }
     }
 }

@@ -37,8 +37,9 @@ pub(crate) struct FastOctave<const W: usize> {
     rows_in: u16,
     config: Config,
     count: [GaussCount; 4],
-    /// Row-filtered input rows of each Gaussian, row `y` in slot `y % 5`.
-    filtered: [[[u16; W]; 5]; 4],
+    /// Row-filtered input rows of each Gaussian (the row stage's exact 26-bit sums), row `y`
+    /// in slot `y % 5`.
+    filtered: [[[u32; W]; 5]; 4],
     /// Scale image rows, row `y` in slot `y % 8`.
     scale: [[[u16; W]; RING]; 4],
     /// DoG rows of the three DoG images, row `y` in slot `y % 3`.
