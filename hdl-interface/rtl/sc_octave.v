@@ -81,6 +81,8 @@ module sc_octave #(
     end
 
     // ---- Gaussian cascade ----
+    // Each Gaussian is a row stage (exact 26-bit sums, no rounding) and a column stage that
+    // rounds once to u16 Q8.8, so that it equals the direct 2-D convolution exactly.
     wire [3:0]  gv;  // output registers of the convolvers (G0 of octaves >= 1: the input)
     wire [63:0] gd;
 
@@ -88,7 +90,7 @@ module sc_octave #(
     generate
         if (INDEX == 0) begin : g_base
             wire        rv;
-            wire [15:0] rd;
+            wire [25:0] rd;  // row-stage sum, unrounded (Q8.18)
             sc_row_conv #(.TAPS(TAPS[0 +: 50])) u_row (
                 .clk(clk), .start(start), .en(en), .width(width), .total(total),
                 .in_valid(in_valid), .in_data(in_data), .out_valid(rv), .out_data(rd));
@@ -102,7 +104,7 @@ module sc_octave #(
         end
         for (i = 1; i < 4; i = i + 1) begin : g_scale
             wire        rv;
-            wire [15:0] rd;
+            wire [25:0] rd;  // row-stage sum, unrounded (Q8.18)
             sc_row_conv #(.TAPS(TAPS[i*50 +: 50])) u_row (
                 .clk(clk), .start(start), .en(en), .width(width), .total(total),
                 .in_valid(gv[i-1]), .in_data(gd[(i-1)*16 +: 16]),

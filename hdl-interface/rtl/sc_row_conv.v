@@ -9,8 +9,12 @@
 // phantom (value 0, never selected: the borders clamp). The output of centre xc is registered
 // when the sample of xc + 2 arrives: latency ROW_LATENCY = 3 enabled clocks.
 //
-// Widths: samples u16 Q8.8; width <= 65535; total = width * height < 2^32 (taken may run two
-// phantoms past it, still < 2^32 for width <= 65535); centre column < width.
+// Widths: samples u16 Q8.8. Output: the exact dot product sum tap*s, unrounded, 26 bits (Q8.18:
+// 1024 * 65535 < 2^26). The column stage rounds once, after both passes, so that the pair
+// equals the direct 2-D convolution with the outer product of the same quantized taps exactly
+// (rounding here too would make the result depend on the pass order by up to one code).
+// width <= 65535; total = width * height < 2^32 (taken may run two phantoms past it, still
+// < 2^32 for width <= 65535); centre column < width.
 `default_nettype none
 
 module sc_row_conv #(
@@ -24,7 +28,7 @@ module sc_row_conv #(
     input  wire        in_valid,
     input  wire [15:0] in_data,   // u16 Q8.8
     output reg         out_valid,
-    output reg  [15:0] out_data   // u16 Q8.8
+    output reg  [25:0] out_data   // sum tap*s, exact (Q8.18)
 );
 
     // Shift register, sh0 newest. The model's fifth entry is only read after the shift, when
@@ -58,8 +62,8 @@ module sc_row_conv #(
     // tap 4: col min(xc+2, last): n0, or n1 (xc = last - 1) / n2 (xc = last)
     wire [15:0] w4 = fits2 ? sample : fits1 ? sh0 : sh1;
 
-    wire [15:0] dot;
-    sc_da_dot #(.TAPS(TAPS)) u_dot (.s({w4, w3, w2, w1, w0}), .y(dot));
+    wire [25:0] dot;
+    sc_da_dot #(.TAPS(TAPS), .IW(16), .SH(0)) u_dot (.s({w4, w3, w2, w1, w0}), .y(dot));
 
     always @(posedge clk) begin
         if (start) begin
