@@ -1,9 +1,12 @@
 //! Why the taps reproduce the design sigmas of table 4.2 and not its "discrete" column, checked
-//! two ways: analytically (the middle DoG of a Gaussian blob must be able to be its scale
-//! extremum) and end to end (synthetic blobs are detected at the octave and scale their size
-//! predicts).
+//! three ways: analytically (the middle DoG of a Gaussian blob must be able to be its scale
+//! extremum), by running kernels with the discrete column through the fast path (they find
+//! next to no point), and end to end (synthetic blobs are detected at the octave and scale
+//! their size predicts).
 
-use stereocal_firmware::fabric::taps::{GAUSS_TAPS, TAP_BITS};
+mod common;
+
+use stereocal_firmware::fabric::taps::{GAUSS_TAPS, TABLE_4_2_DISCRETE_TAPS, TAP_BITS};
 use stereocal_firmware::fabric::{run_frame, Config, Extremum, FastFrontEnd};
 
 /// Whether some blob variance `b` makes |D1| larger than |D0| and |D2| for cascade variance
@@ -34,6 +37,38 @@ fn the_thesis_discrete_column_never_lets_the_middle_dog_win() {
         .map(|t| (8 * t[0] as u32 + 2 * t[1] as u32) as f64 / (1u32 << TAP_BITS) as f64)
         .collect();
     assert!(middle_can_win(1.0, [ours[0], ours[1], ours[2]]));
+}
+
+/// Points the fast path finds on `img` with kernels `taps` and the default configuration.
+fn points_with(taps: [[u16; 5]; 4], img: &[u8], w: usize, h: usize) -> usize {
+    let mut fe = Box::new(FastFrontEnd::<640, 320, 160, 80>::with_kernels(taps));
+    common::run(&mut *fe, &Config::new(w as u16, h as u16), img)
+        .points
+        .len()
+}
+
+#[test]
+fn the_thesis_discrete_column_finds_next_to_nothing_end_to_end() {
+    // The textured test image, and (when the data set is present) a 640x480 crop of a real
+    // frame: hundreds of points with the fabric's taps, next to none with table 4.2's
+    // discrete column.
+    let mut images = vec![(common::random_image(320, 240, 7), 320, 240)];
+    if let Some((img, iw, ih)) = common::real_image() {
+        images.push((common::fit(&img, iw, ih, 640, 480), 640, 480));
+    }
+    for (img, w, h) in images {
+        let ours = points_with(GAUSS_TAPS, &img, w, h);
+        let thesis = points_with(TABLE_4_2_DISCRETE_TAPS, &img, w, h);
+        eprintln!("{w}x{h}: {ours} points with the design column, {thesis} with the discrete");
+        assert!(
+            ours >= 100,
+            "{w}x{h}: only {ours} points with the fabric's taps"
+        );
+        assert!(
+            thesis * 20 <= ours,
+            "{w}x{h}: the discrete column found {thesis} points, the design {ours}"
+        );
+    }
 }
 
 /// A dark-on-bright Gaussian blob of deviation `sigma` at the image centre.

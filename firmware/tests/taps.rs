@@ -3,7 +3,9 @@
 
 use proptest::prelude::*;
 use stereocal_firmware::fabric::convolver::{da_column, da_row};
-use stereocal_firmware::fabric::taps::{da_lut, discrete_sigma, GAUSS_LUTS, GAUSS_TAPS, TAP_BITS};
+use stereocal_firmware::fabric::taps::{
+    da_lut, discrete_sigma, GAUSS_LUTS, GAUSS_TAPS, TABLE_4_2_DISCRETE_TAPS, TAP_BITS,
+};
 
 #[test]
 fn taps_have_unity_dc_gain_and_are_symmetric_unimodal() {
@@ -26,6 +28,17 @@ fn deviations_match_the_design_column_of_table_4_2() {
     for (t, d) in GAUSS_TAPS.iter().zip(design) {
         let s = discrete_sigma(t);
         assert!((s - d).abs() < 5e-4, "{t:?}: sigma {s} vs design {d}");
+    }
+}
+
+#[test]
+fn the_discrete_set_matches_the_discrete_column_of_table_4_2() {
+    let column = [1.1592f64, 0.8292, 0.9354, 1.1040];
+    for (t, d) in TABLE_4_2_DISCRETE_TAPS.iter().zip(column) {
+        assert_eq!(t.iter().map(|&v| v as u32).sum::<u32>(), 1 << TAP_BITS);
+        assert!(t[0] <= t[1] && t[1] <= t[2] && (t[0], t[1]) == (t[4], t[3]));
+        let s = discrete_sigma(t);
+        assert!((s - d).abs() < 5e-4, "{t:?}: sigma {s} vs table 4.2 {d}");
     }
 }
 

@@ -4,6 +4,7 @@ use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::fast::octave::FastOctave;
 use crate::fabric::fast::probe::{NoProbe, Probe};
 use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
+use crate::fabric::taps::{Taps, GAUSS_TAPS};
 
 /// Fast front end with the same width parameters as
 /// [`crate::fabric::pipeline::RegisterFrontEnd`].
@@ -38,17 +39,24 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
     /// Row-memory lengths per octave.
     pub const MAX_WIDTHS: [usize; MAX_OCTAVES] = [W0, W1, W2, W3];
 
-    /// An idle front end.
+    /// An idle front end with the fabric's kernels ([`GAUSS_TAPS`]).
     pub const fn new() -> Self {
+        Self::with_kernels(GAUSS_TAPS)
+    }
+
+    /// An idle front end whose Gaussians G0..G3 use `taps` instead of the fabric's kernels.
+    /// The fabric's kernels are fixed in its LUT ROMs; this exists to measure what other
+    /// kernels would do (`tests/scale_space.rs` runs the thesis' own).
+    pub const fn with_kernels(taps: [Taps; 4]) -> Self {
         const {
             assert!(W1 >= W0.div_ceil(2) && W2 >= W1.div_ceil(2) && W3 >= W2.div_ceil(2));
             assert!(W0 <= u16::MAX as usize);
         }
         Self {
-            o0: FastOctave::new(0),
-            o1: FastOctave::new(1),
-            o2: FastOctave::new(2),
-            o3: FastOctave::new(3),
+            o0: FastOctave::new(0, taps),
+            o1: FastOctave::new(1, taps),
+            o2: FastOctave::new(2, taps),
+            o3: FastOctave::new(3, taps),
             input: [0; W0],
             fifos: OutputFifos::new(),
             config: None,

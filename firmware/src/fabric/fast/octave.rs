@@ -17,7 +17,7 @@ use crate::fabric::fast::probe::Probe;
 use crate::fabric::geometry::octave_dims;
 use crate::fabric::output::{Extremum, OutputFifos};
 use crate::fabric::refine::refine;
-use crate::fabric::taps::GAUSS_TAPS;
+use crate::fabric::taps::Taps;
 
 const RING: usize = 8;
 
@@ -32,6 +32,8 @@ struct GaussCount {
 #[derive(Clone, Debug)]
 pub(crate) struct FastOctave<const W: usize> {
     index: u8,
+    /// G0..G3 (G0 only used by octave 0).
+    taps: [Taps; 4],
     width: u16,
     height: u16,
     rows_in: u16,
@@ -55,9 +57,10 @@ pub(crate) struct FastOctave<const W: usize> {
 }
 
 impl<const W: usize> FastOctave<W> {
-    pub(crate) const fn new(index: u8) -> Self {
+    pub(crate) const fn new(index: u8, taps: [Taps; 4]) -> Self {
         Self {
             index,
+            taps,
             width: 0,
             height: 0,
             rows_in: 0,
@@ -147,7 +150,7 @@ impl<const W: usize> FastOctave<W> {
             let c = &mut self.count[i];
             if let Some(row) = src {
                 row_filter(
-                    &GAUSS_TAPS[i],
+                    &self.taps[i],
                     row,
                     &mut self.filtered[i][c.rows_in as usize % 5],
                 );
@@ -170,7 +173,7 @@ impl<const W: usize> FastOctave<W> {
                     &f[slot(2)][..w],
                 ];
                 column_filter(
-                    &GAUSS_TAPS[i],
+                    &self.taps[i],
                     rows,
                     &mut self.scale[i][r as usize % RING][..w],
                 );
