@@ -7,6 +7,7 @@
 //! starting point and a Cauchy-weighted Gauss-Newton refinement over all matches gives the
 //! answer and its uncertainty.
 
+use rayon::prelude::*;
 use stereocal_hdl::regs::MAX_OCTAVES;
 
 use crate::calib::Calibration;
@@ -150,8 +151,11 @@ impl VergeEstimator {
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> (Vec<Match>, Vec<PixelPair>) {
-        let dl = describe(left, &self.config.descriptor);
-        let dr = describe(right, &self.config.descriptor);
+        // The two images and the matches are independent: both cores work on them.
+        let (dl, dr) = rayon::join(
+            || describe(left, &self.config.descriptor),
+            || describe(right, &self.config.descriptor),
+        );
         let matches = match_descriptors(
             &dl,
             left.keypoints(),
@@ -161,7 +165,7 @@ impl VergeEstimator {
         );
         let planes = left.plane(0).zip(right.plane(0));
         let pairs = matches
-            .iter()
+            .par_iter()
             .filter_map(|m| {
                 let kl = left.keypoints()[m.left as usize];
                 let kr = right.keypoints()[m.right as usize];
