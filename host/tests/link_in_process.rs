@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use stereocal::driver::{Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame};
 use stereocal::frame::Gradients;
-use stereocal::link::InProcessLink;
+use stereocal::link::{InProcessLink, Link};
 use stereocal_firmware::driver::fabric_config;
 use stereocal_firmware::fabric::{run_frame, Extremum, FastFrontEnd, SobelPixel};
 use stereocal_hdl::regs::output_mode::SobelOutput;
@@ -223,4 +223,46 @@ fn register_reads_are_answered_and_bad_images_are_refused() {
             .unwrap(),
         u32::from(W)
     );
+}
+
+/// Everything the link has to read.
+fn drain(link: &mut InProcessLink) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut buf = vec![0u8; 1 << 16];
+    while let Ok(n) = link.recv(&mut buf, std::time::Instant::now()) {
+        out.extend_from_slice(&buf[..n]);
+    }
+    out
+}
+
+#[test]
+fn a_pair_run_on_two_cores_sends_the_bytes_of_one_camera_after_the_other() {
+    let (left, right) = (image(11), image(12));
+    for mode in [SobelOutput::Rows, SobelOutput::Patches] {
+        let mut streams = Vec::new();
+        for concurrent in [true, false] {
+            streams.push(three_pairs(mode, concurrent, &left, &right));
+        }
+        assert!(streams[0].len() > 10_000, "{} bytes", streams[0].len());
+        assert!(
+            streams[0] == streams[1],
+            "{mode:?}: the concurrent pairs' bytes differ"
+        );
+    }
+}
+
+/// The bytes of three pairs, run concurrently or one camera after the other.
+fn three_pairs(mode: SobelOutput, concurrent: bool, left: &[u8], right: &[u8]) -> Vec<u8> {
+    let mut link = InProcessLink::new().expect("device");
+    Driver::new(&mut link).configure(&config(mode), T).unwrap();
+    drain(&mut link);
+    for frame in 0..3u64 {
+        if concurrent {
+            link.submit_pair(left, right, frame * 33_333).unwrap();
+        } else {
+            link.submit(Camera::Left, left, frame * 33_333).unwrap();
+            link.submit(Camera::Right, right, frame * 33_333).unwrap();
+        }
+    }
+    drain(&mut link)
 }

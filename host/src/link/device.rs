@@ -7,8 +7,6 @@
 
 use std::time::Duration;
 
-use stereocal_wire::Camera;
-
 use super::{InProcessLink, Link, LinkError};
 
 /// How long the host waits for the in-process device's answer to one request or one frame.
@@ -54,9 +52,7 @@ impl Device for InProcessLink {
         right: &[u8],
         timestamp_us: u64,
     ) -> Result<(), LinkError> {
-        self.submit(Camera::Left, left, timestamp_us)?;
-        self.submit(Camera::Right, right, timestamp_us)?;
-        Ok(())
+        InProcessLink::submit_pair(self, left, right, timestamp_us).map(|_| ())
     }
 
     fn answer_timeout(&self) -> Duration {

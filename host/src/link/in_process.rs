@@ -7,6 +7,10 @@
 //! that [`Link::recv`] hands out. The fabric runs its fast path unless
 //! [`InProcessLink::register_level`] asks for the clock-level model.
 //!
+//! The two cameras' channels run on two cores at once ([`InProcessLink::submit_pair`]) and
+//! their packets are queued left camera first, numbered as one soft-core serving both would
+//! number them, so the bytes equal the soft-core's.
+//!
 //! Register writes from the host go to both channels (the head's two fabrics are configured
 //! alike); `Hello` and register reads are answered by the left channel, so each request gets
 //! one answer, as from a single device.
@@ -18,7 +22,9 @@ use stereocal_firmware::driver::{
     PacketWriter,
 };
 use stereocal_hdl::RegisterBank;
-use stereocal_wire::{Accumulator, Camera, FeedResult, PacketRepr, MAX_FRAME_LEN};
+use stereocal_wire::{
+    decode, Accumulator, Camera, FeedResult, PacketRepr, DELIMITER, MAX_FRAME_LEN,
+};
 
 use super::{Link, LinkError};
 
@@ -89,18 +95,55 @@ impl InProcessLink {
             .map_err(|e| channel_error(camera, &e))
     }
 
-    /// Runs a stereo pair, left first: the frame's packets of both cameras wait in the
-    /// outbox, the two frames carry the same frame id.
+    /// Runs a stereo pair: the frame's packets of both cameras wait in the outbox, the left
+    /// camera's first, the two frames carry the same frame id.
+    ///
+    /// The channels run concurrently. The left one numbers its packets from the link's next
+    /// sequence number; the right one's are numbered from 0 and, once the left has finished,
+    /// decoded and sent again through the link's writer, which gives them the numbers that
+    /// follow the left camera's: the bytes are those of running the two one after the other.
+    /// A left failure discards the right camera's packets (both channels have used the frame
+    /// number, as after any failed frame).
     pub fn submit_pair(
         &mut self,
         left: &[u8],
         right: &[u8],
         timestamp_us: u64,
     ) -> Result<[FrameSummary; 2], LinkError> {
-        Ok([
-            self.submit(Camera::Left, left, timestamp_us)?,
-            self.submit(Camera::Right, right, timestamp_us)?,
-        ])
+        let start = self.writer.next_seq();
+        let (left_channel, right_channel) = (&mut self.left, &mut self.right);
+        let ((left_result, left_out), (right_result, right_out)) = rayon::join(
+            || {
+                let mut out = PacketWriter::continuing_at(Outbox::default(), start);
+                let result = left_channel.process_frame(left, timestamp_us, &mut out);
+                (result, out)
+            },
+            || {
+                let mut out = PacketWriter::new(Outbox::default());
+                let result = right_channel.process_frame(right, timestamp_us, &mut out);
+                (result, out)
+            },
+        );
+        let left_next = left_out.next_seq();
+        self.writer.sink_mut().write(&left_out.into_sink().bytes);
+        self.writer.set_next_seq(left_next);
+        let left_summary = left_result.map_err(|e| channel_error(Camera::Left, &e))?;
+        let mut right_bytes = right_out.into_sink().bytes;
+        for frame in right_bytes.split_mut(|&b| b == DELIMITER) {
+            if frame.is_empty() {
+                continue;
+            }
+            let (_, packet) = decode(frame).map_err(|e| {
+                LinkError::Device(format!(
+                    "right channel: its own packet does not decode: {e}"
+                ))
+            })?;
+            self.writer
+                .send(&packet)
+                .map_err(|e| LinkError::Device(format!("right channel: re-encoding: {e}")))?;
+        }
+        let right_summary = right_result.map_err(|e| channel_error(Camera::Right, &e))?;
+        Ok([left_summary, right_summary])
     }
 
     /// Bytes the device sent that the host has not read yet.
