@@ -1,6 +1,6 @@
 #!/bin/sh
-# Runs the convolver testbench (sc_row_conv + sc_col_conv against a direct reference) with
-# Icarus Verilog: prints PASS, exits 1 on a failure.
+# Runs the convolver testbench (sc_row_conv + sc_col_conv against a direct 2-D convolution with
+# one rounding, for the four kernels) with Icarus Verilog: prints PASS, exits 1 on a failure.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 out=$(mktemp -d)
