@@ -41,10 +41,19 @@ fn the_thesis_discrete_column_never_lets_the_middle_dog_win() {
 
 /// Points the fast path finds on `img` with kernels `taps` and the default configuration.
 fn points_with(taps: [[u16; 5]; 4], img: &[u8], w: usize, h: usize) -> usize {
-    let mut fe = Box::new(FastFrontEnd::<640, 320, 160, 80>::with_kernels(taps));
+    let mut fe =
+        Box::new(FastFrontEnd::<640, 320, 160, 80>::with_kernels(taps).expect("symmetric"));
     common::run(&mut *fe, &Config::new(w as u16, h as u16), img)
         .points
         .len()
+}
+
+#[test]
+fn asymmetric_kernels_are_refused() {
+    let mut taps = GAUSS_TAPS;
+    taps[2] = [56, 249, 412, 250, 57];
+    assert!(FastFrontEnd::<64, 32, 16, 8>::with_kernels(taps).is_none());
+    assert!(FastFrontEnd::<64, 32, 16, 8>::with_kernels(GAUSS_TAPS).is_some());
 }
 
 #[test]

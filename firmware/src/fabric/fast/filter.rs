@@ -31,15 +31,13 @@ fn row_dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u32 {
 }
 
 /// The column stage's once-rounded result `(Σ t·v + 2^19) >> 20` of five 26-bit row sums, in
-/// 64-bit lanes (32x32 -> 64-bit multiplies, which SSE2 has as `pmuludq`; measured faster than
-/// splitting the sums into 13-bit halves for 32-bit lanes). Equal to
-/// [`crate::fabric::convolver::da_column`].
+/// 64-bit lanes (32x32 -> 64-bit multiplies, which SSE2 has as `pmuludq`). The kernels are
+/// symmetric (`tests/taps.rs`), so mirrored rows are added first (27 bits) and three products
+/// suffice. Equal to [`crate::fabric::convolver::da_column`].
 #[inline(always)]
 fn column_dot(t: &Taps, v: [u32; 5]) -> u16 {
-    let mut s = 0u64;
-    for (&t, v) in t.iter().zip(v) {
-        s += u64::from(t) * u64::from(v);
-    }
+    let m = |t: u16, v: u32| u64::from(t) * u64::from(v);
+    let s = m(t[0], v[0] + v[4]) + m(t[1], v[1] + v[3]) + m(t[2], v[2]);
     ((s + (1 << (2 * TAP_BITS - 1))) >> (2 * TAP_BITS)) as u16
 }
 

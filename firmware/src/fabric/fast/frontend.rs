@@ -41,13 +41,26 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
 
     /// An idle front end with the fabric's kernels ([`GAUSS_TAPS`]).
     pub const fn new() -> Self {
-        Self::with_kernels(GAUSS_TAPS)
+        Self::build(GAUSS_TAPS)
     }
 
-    /// An idle front end whose Gaussians G0..G3 use `taps` instead of the fabric's kernels.
-    /// The fabric's kernels are fixed in its LUT ROMs; this exists to measure what other
-    /// kernels would do (`tests/scale_space.rs` runs the thesis' own).
-    pub const fn with_kernels(taps: [Taps; 4]) -> Self {
+    /// An idle front end whose Gaussians G0..G3 use `taps` instead of the fabric's kernels,
+    /// or `None` if a kernel is not symmetric (the column pass relies on it, as every
+    /// Gaussian is). The fabric's kernels are fixed in its LUT ROMs; this exists to measure
+    /// what other kernels would do (`tests/scale_space.rs` runs the thesis' own).
+    pub const fn with_kernels(taps: [Taps; 4]) -> Option<Self> {
+        let mut k = 0;
+        while k < taps.len() {
+            let t = taps[k];
+            if t[0] != t[4] || t[1] != t[3] {
+                return None;
+            }
+            k += 1;
+        }
+        Some(Self::build(taps))
+    }
+
+    const fn build(taps: [Taps; 4]) -> Self {
         const {
             assert!(W1 >= W0.div_ceil(2) && W2 >= W1.div_ceil(2) && W3 >= W2.div_ceil(2));
             assert!(W0 <= u16::MAX as usize);
