@@ -34,6 +34,21 @@ fn rtl_available(test: &str) -> bool {
     }
 }
 
+/// A co-simulation test: without the RTL model it prints the loud skip line and passes
+/// (failing under `CI=true`); the body only exists where the model was built.
+macro_rules! rtl_test {
+    ($name:ident, $body:block) => {
+        #[test]
+        fn $name() {
+            if !rtl_available(stringify!($name)) {
+                return;
+            }
+            #[cfg(rtl_sim)]
+            $body
+        }
+    };
+}
+
 /// splitmix64: deterministic test images without an RNG dependency.
 struct Rng(u64);
 
@@ -223,270 +238,214 @@ mod sim {
     }
 }
 
-#[test]
-fn rtl_random_images() {
-    if !rtl_available("rtl_random_images") {
-        return;
+rtl_test!(rtl_random_images, {
+    let mut b = sim::Bench::new();
+    // (w, h, octaves, sobel_scale, edge_ratio, threshold, max_offset), seed
+    let cases = [
+        ((64, 48, 4, 1, 10, 256, 4096), 1),
+        ((37, 29, 4, 0, 0, 0, 8191), 2),
+        ((50, 41, 3, 2, 10, 64, 2048), 3),
+        ((23, 70, 2, 3, 0, 1024, 4096), 4),
+        ((96, 64, 4, 3, 10, 128, 8191), 5),
+        ((31, 17, 1, 1, 0, 256, 1000), 6),
+        ((120, 33, 4, 2, 0, 256, 4096), 7),
+        ((45, 45, 3, 0, 10, 512, 0), 8),
+    ];
+    let mut points = 0;
+    for ((w, h, octaves, sobel_scale, edge_ratio, thr, off), seed) in cases {
+        let cfg = Config {
+            sobel_scale,
+            edge_ratio,
+            contrast_threshold: thr,
+            max_offset: off,
+            ..config(w, h, octaves)
+        };
+        let img = if seed % 2 == 0 {
+            noise(w as usize, h as usize, seed)
+        } else {
+            blobs(w as usize, h as usize, seed)
+        };
+        let run = b.frame(&format!("random seed {seed}"), &cfg, &img, None);
+        points += run.counts.points.iter().sum::<u64>();
     }
-    #[cfg(rtl_sim)]
-    {
-        let mut b = sim::Bench::new();
-        // (w, h, octaves, sobel_scale, edge_ratio, threshold, max_offset), seed
-        let cases = [
-            ((64, 48, 4, 1, 10, 256, 4096), 1),
-            ((37, 29, 4, 0, 0, 0, 8191), 2),
-            ((50, 41, 3, 2, 10, 64, 2048), 3),
-            ((23, 70, 2, 3, 0, 1024, 4096), 4),
-            ((96, 64, 4, 3, 10, 128, 8191), 5),
-            ((31, 17, 1, 1, 0, 256, 1000), 6),
-            ((120, 33, 4, 2, 0, 256, 4096), 7),
-            ((45, 45, 3, 0, 10, 512, 0), 8),
-        ];
-        let mut points = 0;
-        for ((w, h, octaves, sobel_scale, edge_ratio, thr, off), seed) in cases {
-            let cfg = Config {
-                sobel_scale,
-                edge_ratio,
-                contrast_threshold: thr,
-                max_offset: off,
-                ..config(w, h, octaves)
-            };
-            let img = if seed % 2 == 0 {
-                noise(w as usize, h as usize, seed)
-            } else {
-                blobs(w as usize, h as usize, seed)
-            };
-            let run = b.frame(&format!("random seed {seed}"), &cfg, &img, None);
-            points += run.counts.points.iter().sum::<u64>();
-        }
-        assert!(points > 0, "no point in any random image");
-    }
-}
+    assert!(points > 0, "no point in any random image");
+});
 
-#[test]
-fn rtl_random_configurations() {
-    if !rtl_available("rtl_random_configurations") {
-        return;
+rtl_test!(rtl_random_configurations, {
+    // Sizes, octave counts and every other setting drawn at random (valid ones only).
+    let mut b = sim::Bench::new();
+    let mut r = Rng(0x5eed);
+    let mut points = 0;
+    let mut frames = 0;
+    while frames < 40 {
+        let (w, h) = (3 + r.below(160) as u16, 3 + r.below(90) as u16);
+        let cfg = Config {
+            octaves: 1 + r.below(4) as u8,
+            contrast_threshold: [0, 32, 128, 256, 700, 4000][r.below(6) as usize],
+            edge_ratio: [0, 1, 5, 10, 12, 255][r.below(6) as usize],
+            sobel_scale: r.below(4) as u8,
+            max_offset: r.below(8192) as u16,
+            ..Config::new(w, h)
+        };
+        if cfg.validate([1280, 640, 320, 160]).is_err() {
+            continue;
+        }
+        let seed = r.next();
+        let img = match seed % 3 {
+            0 => noise(w as usize, h as usize, seed),
+            _ => blobs(w as usize, h as usize, seed),
+        };
+        let run = b.frame(&format!("random configuration {frames}"), &cfg, &img, None);
+        points += run.counts.points.iter().sum::<u64>();
+        frames += 1;
     }
-    #[cfg(rtl_sim)]
-    {
-        // Sizes, octave counts and every other setting drawn at random (valid ones only).
-        let mut b = sim::Bench::new();
-        let mut r = Rng(0x5eed);
-        let mut points = 0;
-        let mut frames = 0;
-        while frames < 40 {
-            let (w, h) = (3 + r.below(160) as u16, 3 + r.below(90) as u16);
-            let cfg = Config {
-                octaves: 1 + r.below(4) as u8,
-                contrast_threshold: [0, 32, 128, 256, 700, 4000][r.below(6) as usize],
-                edge_ratio: [0, 1, 5, 10, 12, 255][r.below(6) as usize],
-                sobel_scale: r.below(4) as u8,
-                max_offset: r.below(8192) as u16,
-                ..Config::new(w, h)
-            };
-            if cfg.validate([1280, 640, 320, 160]).is_err() {
-                continue;
+    assert!(points > 0, "no point in any random configuration");
+});
+
+rtl_test!(rtl_random_with_idle_clocks, {
+    // Pixels with random gaps (clocks without a pixel) inside rows and between rows.
+    let mut b = sim::Bench::new();
+    for (w, h, octaves, seed) in [(40u16, 36u16, 4u8, 11u64), (29, 21, 3, 12)] {
+        let img = blobs(w as usize, h as usize, seed);
+        let mut r = Rng(seed);
+        let mut stim = Vec::new();
+        for &p in &img {
+            for _ in 0..[0, 0, 0, 1, 2, 5][r.below(6) as usize] {
+                stim.push(None);
             }
-            let seed = r.next();
-            let img = match seed % 3 {
-                0 => noise(w as usize, h as usize, seed),
-                _ => blobs(w as usize, h as usize, seed),
-            };
-            let run = b.frame(&format!("random configuration {frames}"), &cfg, &img, None);
-            points += run.counts.points.iter().sum::<u64>();
-            frames += 1;
+            stim.push(Some(p));
         }
-        assert!(points > 0, "no point in any random configuration");
+        let cfg = config(w, h, octaves);
+        let run = b.frame(&format!("idle clocks seed {seed}"), &cfg, &img, Some(stim));
+        assert!(run.counts.points.iter().sum::<u64>() > 0, "no point");
     }
-}
+});
 
-#[test]
-fn rtl_random_with_idle_clocks() {
-    if !rtl_available("rtl_random_with_idle_clocks") {
-        return;
-    }
-    #[cfg(rtl_sim)]
-    {
-        // Pixels with random gaps (clocks without a pixel) inside rows and between rows.
-        let mut b = sim::Bench::new();
-        for (w, h, octaves, seed) in [(40u16, 36u16, 4u8, 11u64), (29, 21, 3, 12)] {
-            let img = blobs(w as usize, h as usize, seed);
-            let mut r = Rng(seed);
-            let mut stim = Vec::new();
-            for &p in &img {
-                for _ in 0..[0, 0, 0, 1, 2, 5][r.below(6) as usize] {
-                    stim.push(None);
-                }
-                stim.push(Some(p));
-            }
-            let cfg = config(w, h, octaves);
-            let run = b.frame(&format!("idle clocks seed {seed}"), &cfg, &img, Some(stim));
-            assert!(run.counts.points.iter().sum::<u64>() > 0, "no point");
-        }
-    }
-}
-
-#[test]
-fn rtl_configuration_sweep() {
-    if !rtl_available("rtl_configuration_sweep") {
-        return;
-    }
-    #[cfg(rtl_sim)]
-    {
-        // Every octave count x Sobel scale x edge ratio, thresholds and offsets cycling.
-        let mut b = sim::Bench::new();
-        let thresholds = [0u16, 64, 256, 1024, 65535];
-        let offsets = [0u16, 1000, 4096, 8191, 2048, 7000];
-        let mut i = 0usize;
-        let mut points = 0;
-        for octaves in 1..=4u8 {
-            for sobel_scale in 0..=3u8 {
-                for edge_ratio in [0u8, 10] {
-                    let (w, h) = (40 + 7 * (i % 5) as u16, 34 + 5 * (i % 3) as u16);
-                    let cfg = Config {
-                        sobel_scale,
-                        edge_ratio,
-                        contrast_threshold: thresholds[i % thresholds.len()],
-                        max_offset: offsets[i % offsets.len()],
-                        ..config(w, h, octaves)
-                    };
-                    let img = blobs(w as usize, h as usize, 100 + i as u64);
-                    let run = b.frame(&format!("sweep {i}"), &cfg, &img, None);
-                    points += run.counts.points.iter().sum::<u64>();
-                    i += 1;
-                }
+rtl_test!(rtl_configuration_sweep, {
+    // Every octave count x Sobel scale x edge ratio, thresholds and offsets cycling.
+    let mut b = sim::Bench::new();
+    let thresholds = [0u16, 64, 256, 1024, 65535];
+    let offsets = [0u16, 1000, 4096, 8191, 2048, 7000];
+    let mut i = 0usize;
+    let mut points = 0;
+    for octaves in 1..=4u8 {
+        for sobel_scale in 0..=3u8 {
+            for edge_ratio in [0u8, 10] {
+                let (w, h) = (40 + 7 * (i % 5) as u16, 34 + 5 * (i % 3) as u16);
+                let cfg = Config {
+                    sobel_scale,
+                    edge_ratio,
+                    contrast_threshold: thresholds[i % thresholds.len()],
+                    max_offset: offsets[i % offsets.len()],
+                    ..config(w, h, octaves)
+                };
+                let img = blobs(w as usize, h as usize, 100 + i as u64);
+                let run = b.frame(&format!("sweep {i}"), &cfg, &img, None);
+                points += run.counts.points.iter().sum::<u64>();
+                i += 1;
             }
         }
-        assert!(points > 0, "no point in the sweep");
     }
-}
+    assert!(points > 0, "no point in the sweep");
+});
 
-#[test]
-fn rtl_aborted_frames_and_power_up() {
-    if !rtl_available("rtl_aborted_frames_and_power_up") {
-        return;
-    }
-    #[cfg(rtl_sim)]
-    {
-        // Registers and memories power up random; frames are abandoned part way (in the
-        // middle of the image, during the flush) and restarted with another size: `start`
-        // must leave nothing behind that reaches an output.
-        for seed in [1u32, 77] {
-            let mut b = sim::Bench::with_power_up(seed);
-            let (w, h) = (52u16, 44u16);
-            let img = blobs(w as usize, h as usize, seed as u64);
-            let cfg = config(w, h, 4);
-            for cut in [0usize, 1, 700, (w as usize * h as usize)] {
-                let mut stim = back_to_back(&img[..cut]);
-                stim.extend(std::iter::repeat_n(None, 150 * (seed as usize % 3)));
-                b.partial("aborted", &cfg, &stim);
-            }
-            let cfg2 = Config {
-                sobel_scale: 2,
-                ..config(37, 61, 3)
-            };
-            let img2 = noise(37, 61, seed as u64 + 5);
-            b.frame("after aborted frames", &cfg2, &img2, None);
-            b.frame("random power-up", &cfg, &img, None);
+rtl_test!(rtl_aborted_frames_and_power_up, {
+    // Registers and memories power up random; frames are abandoned part way (in the
+    // middle of the image, during the flush) and restarted with another size: `start`
+    // must leave nothing behind that reaches an output.
+    for seed in [1u32, 77] {
+        let mut b = sim::Bench::with_power_up(seed);
+        let (w, h) = (52u16, 44u16);
+        let img = blobs(w as usize, h as usize, seed as u64);
+        let cfg = config(w, h, 4);
+        for cut in [0usize, 1, 700, (w as usize * h as usize)] {
+            let mut stim = back_to_back(&img[..cut]);
+            stim.extend(std::iter::repeat_n(None, 150 * (seed as usize % 3)));
+            b.partial("aborted", &cfg, &stim);
         }
+        let cfg2 = Config {
+            sobel_scale: 2,
+            ..config(37, 61, 3)
+        };
+        let img2 = noise(37, 61, seed as u64 + 5);
+        b.frame("after aborted frames", &cfg2, &img2, None);
+        b.frame("random power-up", &cfg, &img, None);
     }
-}
+});
 
 #[cfg(rtl_sim)]
 use stereocal_hil::rtl::back_to_back;
 
-#[test]
-fn rtl_edge_cases() {
-    if !rtl_available("rtl_edge_cases") {
-        return;
-    }
-    #[cfg(rtl_sim)]
-    {
-        let mut b = sim::Bench::new();
-        let (w, h) = (48usize, 40usize);
-        let cases: Vec<(&str, Vec<u8>, u8)> = vec![
-            ("all black", vec![0; w * h], 1),
-            ("all white", vec![255; w * h], 0),
-            ("checkerboard 1", checkerboard(w, h, 1), 1),
-            ("checkerboard 4", checkerboard(w, h, 4), 2),
-            ("impulses on black", impulses(w, h, 0, 9), 1),
-            ("impulses on white", impulses(w, h, 255, 9), 3),
-            ("2x2 squares", even_squares(w, h, 2, 9), 1),
-            ("4x4 squares", even_squares(w, h, 4, 12), 0),
-        ];
-        for (name, img, sobel_scale) in cases {
-            for edge_ratio in [10, 0] {
-                let cfg = Config {
-                    sobel_scale,
-                    edge_ratio,
-                    ..config(w as u16, h as u16, 4)
-                };
-                let run = b.frame(name, &cfg, &img, None);
-                if name.starts_with("all") {
-                    assert_eq!(run.counts.points, [0; 4], "{name}: points on a flat image");
-                }
-                if name.starts_with("impulses") {
-                    // A one-pixel impulse is finer than octave 0's scales: its blobs are
-                    // octave 1 extrema (one per impulse at this spacing).
-                    assert!(run.counts.points[1] > 0, "{name}: no point at an impulse");
-                }
+rtl_test!(rtl_edge_cases, {
+    let mut b = sim::Bench::new();
+    let (w, h) = (48usize, 40usize);
+    let cases: Vec<(&str, Vec<u8>, u8)> = vec![
+        ("all black", vec![0; w * h], 1),
+        ("all white", vec![255; w * h], 0),
+        ("checkerboard 1", checkerboard(w, h, 1), 1),
+        ("checkerboard 4", checkerboard(w, h, 4), 2),
+        ("impulses on black", impulses(w, h, 0, 9), 1),
+        ("impulses on white", impulses(w, h, 255, 9), 3),
+        ("2x2 squares", even_squares(w, h, 2, 9), 1),
+        ("4x4 squares", even_squares(w, h, 4, 12), 0),
+    ];
+    for (name, img, sobel_scale) in cases {
+        for edge_ratio in [10, 0] {
+            let cfg = Config {
+                sobel_scale,
+                edge_ratio,
+                ..config(w as u16, h as u16, 4)
+            };
+            let run = b.frame(name, &cfg, &img, None);
+            if name.starts_with("all") {
+                assert_eq!(run.counts.points, [0; 4], "{name}: points on a flat image");
+            }
+            if name.starts_with("impulses") {
+                // A one-pixel impulse is finer than octave 0's scales: its blobs are
+                // octave 1 extrema (one per impulse at this spacing).
+                assert!(run.counts.points[1] > 0, "{name}: no point at an impulse");
             }
         }
     }
-}
+});
 
-#[test]
-fn rtl_maximum_width() {
-    if !rtl_available("rtl_maximum_width") {
-        return;
-    }
-    #[cfg(rtl_sim)]
-    {
-        let mut b = sim::Bench::new();
-        let (w, h) = (1280u16, 20u16);
-        let img = blobs(w as usize, h as usize, 21);
-        let run = b.frame("maximum width", &config(w, h, 4), &img, None);
-        assert!(run.counts.points.iter().sum::<u64>() > 0, "no point");
-        let cfg = Config {
-            sobel_scale: 0,
-            ..config(w, 3, 1)
-        };
-        b.frame(
-            "maximum width, 3 rows",
-            &cfg,
-            &noise(w as usize, 3, 22),
-            None,
-        );
-    }
-}
+rtl_test!(rtl_maximum_width, {
+    let mut b = sim::Bench::new();
+    let (w, h) = (1280u16, 20u16);
+    let img = blobs(w as usize, h as usize, 21);
+    let run = b.frame("maximum width", &config(w, h, 4), &img, None);
+    assert!(run.counts.points.iter().sum::<u64>() > 0, "no point");
+    let cfg = Config {
+        sobel_scale: 0,
+        ..config(w, 3, 1)
+    };
+    b.frame(
+        "maximum width, 3 rows",
+        &cfg,
+        &noise(w as usize, 3, 22),
+        None,
+    );
+});
 
-#[test]
-fn rtl_minimum_sizes() {
-    if !rtl_available("rtl_minimum_sizes") {
-        return;
-    }
-    #[cfg(rtl_sim)]
-    {
-        let mut b = sim::Bench::new();
-        // The smallest frames Config::validate accepts per octave count (last octave 3x3),
-        // square and with one side at its minimum.
-        for (octaves, min) in [(1u8, 3u16), (2, 5), (3, 9), (4, 17)] {
-            for (w, h) in [(min, min), (min, 2 * min + 1), (2 * min + 3, min)] {
-                let cfg = config(w, h, octaves);
-                assert!(cfg.validate([1280, 640, 320, 160]).is_ok());
-                let smaller = config(w - 1, h, octaves);
-                if w == min {
-                    assert!(smaller.validate([1280, 640, 320, 160]).is_err());
-                }
-                for seed in [31u64, 32] {
-                    let img = noise(w as usize, h as usize, seed + w as u64 * 97 + h as u64);
-                    b.frame(&format!("minimum {octaves} octaves"), &cfg, &img, None);
-                }
+rtl_test!(rtl_minimum_sizes, {
+    let mut b = sim::Bench::new();
+    // The smallest frames Config::validate accepts per octave count (last octave 3x3),
+    // square and with one side at its minimum.
+    for (octaves, min) in [(1u8, 3u16), (2, 5), (3, 9), (4, 17)] {
+        for (w, h) in [(min, min), (min, 2 * min + 1), (2 * min + 3, min)] {
+            let cfg = config(w, h, octaves);
+            assert!(cfg.validate([1280, 640, 320, 160]).is_ok());
+            let smaller = config(w - 1, h, octaves);
+            if w == min {
+                assert!(smaller.validate([1280, 640, 320, 160]).is_err());
+            }
+            for seed in [31u64, 32] {
+                let img = noise(w as usize, h as usize, seed + w as u64 * 97 + h as u64);
+                b.frame(&format!("minimum {octaves} octaves"), &cfg, &img, None);
             }
         }
     }
-}
+});
 
 /// A centred `w` x `h` crop of a real photograph under ../shared/data/real, read at run time
 /// (`None`, loudly, when the data set is absent outside CI).
