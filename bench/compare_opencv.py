@@ -3,7 +3,11 @@
 
 Each rectified ETH3D pair in ../shared/data/real/eth3d_two_view (or $STEREOCAL_REAL_DATA)
 becomes one moving-head sequence with an exactly injected verge (`stereocal inject`, as in
-bench/injected_real.sh). Both methods then read the same PNG files with the same calib.toml:
+bench/injected_real.sh); so does `playground` resized for frames of KITTI's size (scaled to
+1352 wide with cv2.INTER_AREA, the centre 392 rows kept, the intrinsics scaled and shifted to
+match; `stereocal inject` crops the warped frames to 1264x376, which the fabric takes whole:
+KITTI's 1264x372 would run as a 1264x368 window). Both methods then read the same PNG files with the same
+calib.toml:
 
 * stereocal: `stereocal run --truth --json` (default settings).
 * OpenCV: SIFT (cv2.SIFT_create(), default settings) on both images, brute-force L2 matching
@@ -43,7 +47,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 VENV = os.path.join(ROOT, "bench", ".venv")
 VENV_PY = os.path.join(VENV, "bin", "python")
 PACKAGES = ["numpy", "opencv-python-headless"]
-SCENES = ("terrace", "playground")
+# (scene, size to resize and centre-crop to, or None for the original).
+SCENES = (("terrace", None), ("playground", None), ("playground", (1352, 392)))
 MOTION = "moving"
 RATIO = 0.8
 MIN_POINTS = 5  # fewest ratio-test matches to try E; fewest points in front for a "firm" pose
@@ -236,6 +241,33 @@ def sign_check(binary, work):
         raise SystemExit("OpenCV verge sign check failed; not trusting the comparison")
 
 
+def resized_pair(left_png, right_png, cams, size, out_dir):
+    """The pair scaled to `size[0]` wide (INTER_AREA) and cropped to the centre `size[1]` rows,
+    written as PNGs into `out_dir`, with the intrinsics to match (pixel centres at integers:
+    c' = (c + 0.5) s - 0.5, minus the crop offset for cy)."""
+    import cv2
+
+    os.makedirs(out_dir)
+    out, y0, s = [], None, None
+    for name, path in (("im0.png", left_png), ("im1.png", right_png)):
+        img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+        h, w = img.shape
+        s = size[0] / w
+        scaled = cv2.resize(img, (size[0], round(h * s)), interpolation=cv2.INTER_AREA)
+        if scaled.shape[0] < size[1]:
+            raise SystemExit(f"{path}: {scaled.shape[0]} rows after scaling, need {size[1]}")
+        y0 = (scaled.shape[0] - size[1]) // 2
+        dst = os.path.join(out_dir, name)
+        cv2.imwrite(dst, scaled[y0:y0 + size[1]])
+        out.append(dst)
+    scaled_cams = {
+        cam: {"fx": c["fx"] * s, "fy": c["fy"] * s, "cx": (c["cx"] + 0.5) * s - 0.5,
+              "cy": (c["cy"] + 0.5) * s - 0.5 - y0}
+        for cam, c in cams.items()
+    }
+    return out[0], out[1], scaled_cams
+
+
 def main():
     import argparse
     import json
@@ -264,20 +296,28 @@ def main():
     try:
         sign_check(binary, work)
         rows = []
-        for scene in SCENES:
+        for scene, resize in SCENES:
             g = geometry[scene]
+            left_png = os.path.join(data, scene, "im0.png")
+            right_png = os.path.join(data, scene, "im1.png")
+            cams = {cam: {k: float(g[cam][k]) for k in ("fx", "fy", "cx", "cy")}
+                    for cam in ("cam0", "cam1")}
+            if resize is not None:
+                scene = f"{scene}_resized"
+                left_png, right_png, cams = resized_pair(left_png, right_png, cams, resize,
+                                                         os.path.join(work, scene))
             toml = os.path.join(work, f"{scene}.toml")
             with open(toml, "w") as f:
                 f.write(f"baseline_m = {g['stereo']['baseline_m']!r}\n")
                 for side, cam in (("left", "cam0"), ("right", "cam1")):
                     f.write(f"[{side}]\n")
                     for k in ("fx", "fy", "cx", "cy"):
-                        f.write(f"{k} = {float(g[cam][k])!r}\n")
+                        f.write(f"{k} = {cams[cam][k]!r}\n")
             seq = os.path.join(work, f"{scene}_{MOTION}")
             print(f"{scene}: inject {args.frames} frames, run stereocal, run OpenCV",
                   file=sys.stderr)
-            sh([binary, "inject", "--left-image", os.path.join(data, scene, "im0.png"),
-                "--right-image", os.path.join(data, scene, "im1.png"), "--calib", toml,
+            sh([binary, "inject", "--left-image", left_png,
+                "--right-image", right_png, "--calib", toml,
                 "--frames", str(args.frames), "--motion", MOTION, "--out", seq])
             sc = json.loads(sh([binary, "run", "--left", os.path.join(seq, "left"),
                                 "--right", os.path.join(seq, "right"),
@@ -304,8 +344,8 @@ def main():
           f"Matches are ratio-test matches (stereocal at its default ratio 0.6, OpenCV at "
           f"{RATIO}). Speed-up = OpenCV ms/pair / stereocal ms/pair.\n")
     print("| scene | size | method | estimated | raw median | raw p95 | raw max "
-          "| residual removed | median matches | ms/pair | stereocal speed-up |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "| residual removed | median matches | ms/pair | pairs/s | stereocal speed-up |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for scene, size, sc, cvr in rows:
         ratio = cvr["ms_per_frame_pair"] / sc["ms_per_frame_pair"]
         firm = dict(cvr["firm"], ms_per_frame_pair=cvr["ms_per_frame_pair"])
@@ -318,7 +358,8 @@ def main():
                      f(r["median_abs_err_deg"]), f(r["p95_abs_err_deg"]),
                      f(r["max_abs_err_deg"]), f(r["residual_removed_deg"]),
                      "-" if mm is None else "%.0f" % mm,
-                     "%.2f" % r["ms_per_frame_pair"], extra]
+                     "%.2f" % r["ms_per_frame_pair"],
+                     "%.1f" % (1000.0 / r["ms_per_frame_pair"]), extra]
             print("| " + " | ".join(cells) + " |")
     print(f"\nTimes: wall ms per pair, one run, PNG decoding excluded on both sides (stereocal: "
           f"fabric model + driver + estimator + filter; OpenCV: SIFT on both images + matching "

@@ -3,7 +3,7 @@
 //!
 //! - `run.sh`: sc_extrema, sc_edge, sc_refine, sc_sobel and sc_cordic against vectors the Rust
 //!   functions produced (checked in);
-//! - `run_conv.sh`: sc_row_conv + sc_col_conv against a direct separable reference;
+//! - `run_conv.sh`: sc_row_conv + sc_col_conv against a direct 2-D convolution with one rounding;
 //! - `sc_regs_run.sh`: the generated register block's access types;
 //! - `sc_fabric_run.sh`: the whole fabric behind its registers — arming, FIFOs, overflow,
 //!   counters, LATENCY_CLOCKS, SOFT_RESET.
