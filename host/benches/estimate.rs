@@ -113,6 +113,12 @@ fn bench(c: &mut Criterion) {
         })
         .collect();
 
+    // The timed estimate must be a real one: parallel cameras, verge 0.
+    let check = estimator
+        .estimate_from_pixels(&pairs)
+        .expect("the benchmark's pairs give an estimate");
+    assert!(check.verge_deg.abs() < 0.01, "verge {}", check.verge_deg);
+
     c.bench_function("describe 2x500 (128)", |b| {
         b.iter(|| {
             (
