@@ -49,9 +49,11 @@ fn points_with(taps: [[u16; 5]; 4], img: &[u8], w: usize, h: usize) -> usize {
 }
 
 #[test]
-fn asymmetric_kernels_are_refused() {
+fn asymmetric_or_unnormalised_kernels_are_refused() {
     let mut taps = GAUSS_TAPS;
     taps[2] = [56, 249, 412, 250, 57];
+    assert!(FastFrontEnd::<64, 32, 16, 8>::with_kernels(taps).is_none());
+    taps[2] = [57, 249, 414, 249, 57];
     assert!(FastFrontEnd::<64, 32, 16, 8>::with_kernels(taps).is_none());
     assert!(FastFrontEnd::<64, 32, 16, 8>::with_kernels(GAUSS_TAPS).is_some());
 }

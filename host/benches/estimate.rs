@@ -118,6 +118,10 @@ fn bench(c: &mut Criterion) {
         .estimate_from_pixels(&pairs)
         .expect("the benchmark's pairs give an estimate");
     assert!(check.verge_deg.abs() < 0.01, "verge {}", check.verge_deg);
+    let full = estimator
+        .estimate(&lf, &rf)
+        .expect("the benchmark's frames give an estimate");
+    assert!(full.verge_deg.abs() < 0.01, "verge {}", full.verge_deg);
 
     c.bench_function("describe 2x500 (128)", |b| {
         b.iter(|| {
@@ -173,23 +177,23 @@ fn bench(c: &mut Criterion) {
     c.bench_function("E+RANSAC+refine only", |b| {
         b.iter(|| estimator.estimate_from_pixels(black_box(&pairs)).ok())
     });
-    c.bench_function("subpixel refine (all matches)", |b| {
-        let (pl, pr) = (lf.plane(0).expect("plane"), rf.plane(0).expect("plane"));
-        b.iter(|| {
-            pairs
-                .iter()
-                .filter_map(|(l, r)| {
-                    refine_pair(
-                        pl,
-                        pr,
-                        [l[0] as f32, l[1] as f32],
-                        [r[0] as f32, r[1] as f32],
-                        &SubpixelConfig::default(),
-                    )
-                })
-                .count()
-        })
-    });
+    let (pl, pr) = (lf.plane(0).expect("plane"), rf.plane(0).expect("plane"));
+    let refine_all = || {
+        pairs
+            .iter()
+            .filter_map(|(l, r)| {
+                refine_pair(
+                    pl,
+                    pr,
+                    [l[0] as f32, l[1] as f32],
+                    [r[0] as f32, r[1] as f32],
+                    &SubpixelConfig::default(),
+                )
+            })
+            .count()
+    };
+    assert!(refine_all() > pairs.len() / 2, "most matches refine");
+    c.bench_function("subpixel refine (all matches)", |b| b.iter(refine_all));
     c.bench_function(
         "full estimate (describe+match+subpixel+RANSAC+refine)",
         |b| b.iter(|| estimator.estimate(black_box(&lf), black_box(&rf)).ok()),

@@ -10,7 +10,8 @@
 //! (the widest integer SIMD the CPU has, picked at run time) on offset-binary copies: `v ^ 0x80`
 //! maps `u8` to `i8` as `v - 128`, which leaves every difference, so every distance, unchanged.
 //! The auto-vectorised loop this replaces spent most of its instructions widening bytes to
-//! 32 bits; the distance is 95 % of the matcher's time.
+//! 32 bits (`cargo bench -p stereocal --bench estimate`, `match only` at 500 keypoints: 629 µs
+//! before, 423 µs after, measured back to back on the same machine when the change was made).
 
 use crate::descriptor::DescriptorSet;
 use crate::frame::Keypoint;
@@ -225,6 +226,7 @@ mod tests {
 
     proptest! {
         #[test]
+        /// Exercises the simsimd kernel this machine's CPU dispatches to.
         fn distance_matches_the_plain_formula(a in proptest::collection::vec(any::<u8>(), 0..140), seed in any::<u8>()) {
             let b: Vec<u8> = a.iter().map(|v| v.wrapping_mul(seed).wrapping_add(3)).collect();
             let plain: u64 = a.iter().zip(&b).map(|(&x, &y)| ((x as i64 - y as i64).pow(2)) as u64).sum();

@@ -266,3 +266,28 @@ fn three_pairs(mode: SobelOutput, concurrent: bool, left: &[u8], right: &[u8]) -
     }
     drain(&mut link)
 }
+
+#[test]
+fn a_refused_left_image_leaves_the_cameras_in_step() {
+    let mut driver = Driver::new(InProcessLink::new().expect("device"));
+    driver.configure(&config(SobelOutput::Rows), T).unwrap();
+    let (left, right) = (image(21), image(22));
+    let err = driver
+        .link_mut()
+        .submit_pair(&left[..10], &right, 0)
+        .unwrap_err();
+    assert!(err.to_string().contains("Left channel"), "{err}");
+    driver
+        .link_mut()
+        .submit_pair(&left, &right, 33_333)
+        .unwrap();
+    let outcome = driver.next_pair(T).expect("pair");
+    let PairOutcome::Pair { left, right } = outcome else {
+        panic!("both cameras of frame 0 expected, got {outcome:?}");
+    };
+    assert_eq!((left.frame_id(), right.frame_id()), (0, 0));
+    assert!(matches!(
+        (left, right),
+        (FrameOutcome::Delivered(_), FrameOutcome::Delivered(_))
+    ));
+}

@@ -194,8 +194,9 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
     /// configuration its registers hold, and sends FrameStart, the frame's PointBatch and
     /// SobelRows/SobelPatch packets (as OUTPUT_MODE.SOBEL_OUTPUT says), then FrameEnd.
     ///
-    /// An error before FrameStart sends nothing; an error after it leaves the frame without a
-    /// FrameEnd (the caller reports the error). Either way the frame number is used up.
+    /// An error before FrameStart sends nothing and leaves the frame number unused; an error
+    /// after it leaves the frame without a FrameEnd (the caller reports the error) and its
+    /// number used up.
     pub fn process_frame<S: ByteSink>(
         &mut self,
         image: &[u8],

@@ -14,8 +14,9 @@ pub const POINT_ENTRY_BITS: usize = 90;
 
 /// Line and alignment memory bits of octave `k` of width `w`, as the RTL (`sc_octave`) sizes
 /// them: its convolvers (four in octave 0, three beyond: G0 is the input there) with four
-/// lines of [`ROW_BITS`] = 26 bits each (the row stage's unrounded sums), the alignment FIFOs of 7, 5 and 3 whole lines of 16 bits (their
-/// occupancy stays below `6w+12`, `4w+8`, `2w+4`, but a line memory comes whole), the DoG
+/// lines of [`ROW_BITS`] = 26 bits each (the row stage's unrounded sums), the alignment FIFOs
+/// of 7, 5 and 3 whole lines of 16 bits (their occupancy stays below `6w+12`, `4w+8`,
+/// `2w+4`, but a line memory comes whole), the DoG
 /// window's two lines of 3 × 16 bits and the Sobel window's two lines of 16 bits.
 pub const fn octave_ram_bits(w: usize, k: usize) -> usize {
     let convolvers = if k == 0 { 4 } else { 3 };

@@ -3,8 +3,9 @@
 //!
 //! # Width and rounding
 //! Taps are unsigned 10-bit integers that sum to exactly `1 << TAP_BITS` = 1024, so the DC gain
-//! is exactly one: a flat image stays flat bit for bit. A convolver output is
-//! `(Σ tap·pixel + 512) >> 10` (round half up).
+//! is exactly one: a flat image stays flat bit for bit. The row pass keeps the exact sum
+//! `Σ tap·pixel` and the column pass rounds once, `(Σ tap·row + 2^19) >> 20` (round half up;
+//! `convolver.rs`).
 //!
 //! # Which sigmas: the design column of table 4.2, not the "discrete" column
 //! Table 4.2 lists the σ the thesis *designed* (0.7664, 0.9656, 1.2166: Lowe's schedule
@@ -19,9 +20,8 @@
 //! [`TABLE_4_2_DISCRETE_TAPS`] are kernels with exactly the thesis' discrete column (G0 1.1592,
 //! then 0.8292, 0.9354, 1.1040), quantized the same way; `tests/scale_space.rs` runs them
 //! through the fast path on the textured test image and on a real frame and checks that they
-//! find next to no point where these taps find hundreds (the demo with them estimates no frame
-//! at all), checks the blob argument for both columns, and that blobs of σ 1.4, 2.8, 5.6 are
-//! found in octaves 0, 1, 2 to within 0.1 pixel with these taps.
+//! find next to no point where [`GAUSS_TAPS`] find hundreds, checks the blob argument for both columns, and that blobs of σ 1.4, 2.8, 5.6 are
+//! found in octaves 0, 1, 2 to within 0.1 pixel with [`GAUSS_TAPS`].
 //! G0, the input filter, runs on the camera image only (octave 0); it brings a camera blur of
 //! σ ≈ 0.5 to the base σ = 1 the cascade expects: `σ_G0 = sqrt(1 - 0.5²) = 0.866`. Octaves 1..
 //! take the subsampled G3 unfiltered (thesis fig. 4.5: input, G1, G2, G3).

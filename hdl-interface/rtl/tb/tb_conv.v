@@ -73,7 +73,7 @@ module tb_conv;
     endgenerate
 
     // The column stage's dot product alone, at exact ties: four random row sums, the fifth
-    // (tap 0, odd in every kernel) solved so that the sum is k * 2^20 + 2^19 + d, d = -1, 0, 1
+    // (G0's tap 0, 35, odd) solved so that the sum is k * 2^20 + 2^19 + d, d = -1, 0, 1
     // (rounds to k, k + 1, k + 1). The rounded unit against the exact one (SH = 0).
     reg  [5*26-1:0] ds;
     wire [15:0]     dy;

@@ -102,14 +102,23 @@ impl InProcessLink {
     /// sequence number; the right one's are numbered from 0 and, once the left has finished,
     /// decoded and sent again through the link's writer, which gives them the numbers that
     /// follow the left camera's: the bytes are those of running the two one after the other.
-    /// A left failure discards the right camera's packets (both channels have used the frame
-    /// number, as after any failed frame).
+    /// Run one after the other, a left frame refused before its `FrameStart` (a wrong image
+    /// size; register errors refuse both alike) would leave the right camera unrun and both
+    /// frame numbers unused: images of different sizes therefore run one after the other, and
+    /// any other failure leaves both channels past the frame, their numbers in step. A left
+    /// failure discards the right camera's packets.
     pub fn submit_pair(
         &mut self,
         left: &[u8],
         right: &[u8],
         timestamp_us: u64,
     ) -> Result<[FrameSummary; 2], LinkError> {
+        if left.len() != right.len() {
+            return Ok([
+                self.submit(Camera::Left, left, timestamp_us)?,
+                self.submit(Camera::Right, right, timestamp_us)?,
+            ]);
+        }
         let start = self.writer.next_seq();
         let (left_channel, right_channel) = (&mut self.left, &mut self.right);
         let ((left_result, left_out), (right_result, right_out)) = rayon::join(

@@ -5,9 +5,10 @@
 //! equal lengths, so that is every pixel), the main loops run over sub-slices of exactly that
 //! length, and the border pixels are read with `get`.
 
+use crate::fabric::convolver::COLUMN_SHIFT;
 use crate::fabric::cordic::{CordicState, ATAN_BAM16};
 use crate::fabric::dog::dog;
-use crate::fabric::taps::{Taps, TAP_BITS};
+use crate::fabric::taps::Taps;
 
 /// `i` clamped to `0..=last` (replicated border); `min`/`max` rather than `clamp`, which
 /// asserts its bounds.
@@ -30,7 +31,8 @@ fn row_dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u32 {
     m(t[0], a) + m(t[1], b) + m(t[2], c) + m(t[3], d) + m(t[4], e)
 }
 
-/// The column stage's once-rounded result `(Σ t·v + 2^19) >> 20` of five 26-bit row sums, in
+/// The column stage's once-rounded result `(Σ t·v + 2^19) >> 20` of five row sums
+/// ([`ROW_BITS`](crate::fabric::convolver::ROW_BITS) wide, at most `1024 · 65535`), in
 /// 64-bit lanes (32x32 -> 64-bit multiplies, which SSE2 has as `pmuludq`). The kernels are
 /// symmetric (`tests/taps.rs`), so mirrored rows are added first (27 bits) and three products
 /// suffice. Equal to [`crate::fabric::convolver::da_column`].
@@ -38,7 +40,7 @@ fn row_dot(t: &Taps, a: u16, b: u16, c: u16, d: u16, e: u16) -> u32 {
 fn column_dot(t: &Taps, v: [u32; 5]) -> u16 {
     let m = |t: u16, v: u32| u64::from(t) * u64::from(v);
     let s = m(t[0], v[0] + v[4]) + m(t[1], v[1] + v[3]) + m(t[2], v[2]);
-    ((s + (1 << (2 * TAP_BITS - 1))) >> (2 * TAP_BITS)) as u16
+    ((s + (1 << (COLUMN_SHIFT - 1))) >> COLUMN_SHIFT) as u16
 }
 
 /// Horizontal 5-tap filter of `src` into `dst` (same length), replicated border: the exact
@@ -201,27 +203,60 @@ pub(crate) fn fold_select(sx: i32, sy: i32) -> CordicState {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fabric::convolver::{da_column, da_row, ROW_BITS};
+    use crate::fabric::convolver::{da_column, da_row};
     use crate::fabric::taps::{GAUSS_LUTS, GAUSS_TAPS};
     use proptest::prelude::*;
 
+    /// The largest sum the row stage produces: all five samples 0xFFFF, taps summing to 1024.
+    const MAX_ROW_SUM: u32 = 1024 * 0xFFFF;
+
+    /// The fast column pass on one pixel of kernel `k`.
+    fn column(k: usize, v: [u32; 5]) -> u16 {
+        let rows = v.map(|v| [v]);
+        let mut out = [0u16];
+        column_filter(
+            &GAUSS_TAPS[k],
+            [&rows[0], &rows[1], &rows[2], &rows[3], &rows[4]],
+            &mut out,
+        );
+        out[0]
+    }
+
     proptest! {
-        /// The column pass equals the 36-bit DA accumulator, including the largest row sums
-        /// and the rounding ties.
+        /// The column pass equals the 36-bit DA accumulator, including the largest row sum
+        /// the row stage can produce.
         #[test]
-        fn column_split_equals_the_da_column(
-            v in prop::array::uniform5(prop_oneof![
-                0u32..1 << ROW_BITS,
-                Just((1u32 << ROW_BITS) - 1),
-                (0u32..1 << 6).prop_map(|k| k << 14),
-            ]),
+        fn column_dot_equals_the_da_column(
+            v in prop::array::uniform5(prop_oneof![0u32..=MAX_ROW_SUM, Just(MAX_ROW_SUM)]),
             k in 0usize..4,
         ) {
-            let t = &GAUSS_TAPS[k];
-            let rows = v.map(|v| [v]);
-            let mut out = [0u16];
-            column_filter(t, [&rows[0], &rows[1], &rows[2], &rows[3], &rows[4]], &mut out);
-            prop_assert_eq!(out[0], da_column(&GAUSS_LUTS[k], v));
+            prop_assert_eq!(column(k, v), da_column(&GAUSS_LUTS[k], v));
+        }
+
+        /// Exact ties `m · 2^20 + 2^19` (and one either side) round up, as the DA does: four
+        /// row sums drawn, the fifth (G0's odd outer tap, 35) solved for the tie.
+        #[test]
+        fn column_dot_rounds_ties_up(
+            rest in prop::array::uniform4(0u32..=MAX_ROW_SUM / 2),
+            d in -1i64..=1,
+        ) {
+            let t = GAUSS_TAPS[0];
+            let partial: i64 = (1..5).map(|j| i64::from(t[j]) * i64::from(rest[j - 1])).sum();
+            // Smallest v0 >= 0 with t0 · v0 + partial ≡ 2^19 + d (mod 2^20); t0 is odd, so it
+            // is invertible modulo 2^20.
+            let modulus = 1i64 << 20;
+            // Newton's iteration doubles the correct low bits: 1, 2, 4, ... 32 >= 20.
+            let mut inverse = 1i64;
+            for _ in 0..5 {
+                inverse = (inverse * (2 - i64::from(t[0]) * inverse)).rem_euclid(modulus);
+            }
+            let v0 = (((1i64 << 19) + d - partial).rem_euclid(modulus) * inverse) % modulus;
+            prop_assume!(v0 <= i64::from(MAX_ROW_SUM));
+            let v = [v0 as u32, rest[0], rest[1], rest[2], rest[3]];
+            let sum: i64 = (0..5).map(|j| i64::from(t[j]) * i64::from(v[j])).sum();
+            prop_assert_eq!(sum.rem_euclid(modulus), (1 << 19) + d);
+            prop_assert_eq!(i64::from(column(0, v)), (sum + (1 << 19)) >> 20);
+            prop_assert_eq!(column(0, v), da_column(&GAUSS_LUTS[0], v));
         }
 
         #[test]

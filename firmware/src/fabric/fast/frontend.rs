@@ -4,7 +4,7 @@ use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::fast::octave::FastOctave;
 use crate::fabric::fast::probe::{NoProbe, Probe};
 use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
-use crate::fabric::taps::{Taps, GAUSS_TAPS};
+use crate::fabric::taps::{Taps, GAUSS_TAPS, TAP_BITS};
 
 /// Fast front end with the same width parameters as
 /// [`crate::fabric::pipeline::RegisterFrontEnd`].
@@ -45,14 +45,17 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
     }
 
     /// An idle front end whose Gaussians G0..G3 use `taps` instead of the fabric's kernels,
-    /// or `None` if a kernel is not symmetric (the column pass relies on it, as every
-    /// Gaussian is). The fabric's kernels are fixed in its LUT ROMs; this exists to measure
-    /// what other kernels would do (`tests/scale_space.rs` runs the thesis' own).
+    /// or `None` unless every kernel is symmetric (the column pass adds mirrored rows first)
+    /// with taps summing to `1 << TAP_BITS` (unity DC gain: the widths of the row sums and of
+    /// the Q8.8 results rest on it), as every Gaussian of the fabric is. The fabric's kernels
+    /// are fixed in its LUT ROMs; this exists to measure what other kernels would do
+    /// (`tests/scale_space.rs` runs the thesis' own).
     pub const fn with_kernels(taps: [Taps; 4]) -> Option<Self> {
         let mut k = 0;
         while k < taps.len() {
             let t = taps[k];
-            if t[0] != t[4] || t[1] != t[3] {
+            let sum = t[0] as u32 + t[1] as u32 + t[2] as u32 + t[3] as u32 + t[4] as u32;
+            if t[0] != t[4] || t[1] != t[3] || sum != 1 << TAP_BITS {
                 return None;
             }
             k += 1;
