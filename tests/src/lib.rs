@@ -231,13 +231,12 @@ pub fn qemu_or_skip(test: &str) -> Option<QemuConfig> {
         .output()
         .is_ok_and(|out| out.status.success());
     if !found {
-        let reason = format!(
-            "{DEFAULT_QEMU} not found on PATH (Debian/Ubuntu: apt-get install qemu-system-misc)"
+        skip(
+            test,
+            &format!(
+                "{DEFAULT_QEMU} not found on PATH (Debian/Ubuntu: apt-get install qemu-system-misc)"
+            ),
         );
-        if std::env::var("CI").as_deref() == Ok("true") {
-            panic!("{test}: {reason}; required under CI=true");
-        }
-        skipped(test, &reason);
         return None;
     }
     Some(QemuConfig::new(firmware_elf()))
@@ -278,24 +277,24 @@ pub fn real_data_or_skip(test: &str) -> Option<PathBuf> {
     if root.join("eth3d_two_view").is_dir() {
         return Some(root);
     }
-    if std::env::var("CI").as_deref() == Ok("true") {
-        panic!(
-            "{test}: real data missing at {} (required under CI=true)",
+    skip(
+        test,
+        &format!(
+            "real data not found at {} (set STEREOCAL_REAL_DATA)",
             root.display()
-        );
-    }
-    let reason = format!(
-        "real data not found at {} (set STEREOCAL_REAL_DATA)",
-        root.display()
+        ),
     );
-    skipped(test, &reason);
     None
 }
 
-/// Says loudly that `test` did not run. Straight to stderr, past the test harness's output
-/// capture, so the line shows in a plain `cargo test` run.
-fn skipped(test: &str, reason: &str) {
+/// `test` cannot run for `reason` (a tool or data set missing): under `CI=true` that is a
+/// failure; elsewhere it says so loudly, straight to stderr, past the test harness's output
+/// capture, so the line shows in a plain `cargo test` run, and the caller returns.
+pub fn skip(test: &str, reason: &str) {
     use std::io::Write;
+    if std::env::var("CI").as_deref() == Ok("true") {
+        panic!("{test}: {reason}; required under CI=true");
+    }
     // A closed stderr has nobody to tell.
     let _ = writeln!(std::io::stderr(), "\n*** SKIPPED {test}: {reason} ***\n");
 }

@@ -11,8 +11,6 @@
     allow(dead_code, unused_imports, clippy::needless_return)
 )]
 
-use std::io::Write;
-
 use stereocal_firmware::fabric::Config;
 
 /// Whether the RTL model exists; prints the loud skip line when it does not.
@@ -20,15 +18,7 @@ fn rtl_available(test: &str) -> bool {
     match stereocal_hil::rtl::SKIP {
         None => true,
         Some(why) => {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "RTL model missing under CI=true: {why}"
-            );
-            // Straight to stderr: the test harness captures `eprintln!` of passing tests.
-            let _ = writeln!(
-                std::io::stderr(),
-                "\n!!! SKIPPED {test}: RTL co-simulation not built: {why} !!!\n"
-            );
+            stereocal_hil::skip(test, &format!("RTL co-simulation not built: {why}"));
             false
         }
     }
@@ -450,21 +440,12 @@ rtl_test!(rtl_minimum_sizes, {
 /// A centred `w` x `h` crop of a real photograph under ../shared/data/real, read at run time
 /// (`None`, loudly, when the data set is absent outside CI).
 fn real_crop(rel: &str, w: usize, h: usize) -> Option<Vec<u8>> {
-    let path = format!(
-        "{}/../../shared/data/real/{rel}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    if !std::path::Path::new(&path).exists() {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "real image missing under CI=true: {path}"
-        );
-        let _ = writeln!(
-            std::io::stderr(),
-            "\n!!! SKIPPING rtl_real_images: {path} not found !!!\n"
-        );
+    let path = stereocal_hil::real_data_or_skip("rtl_real_images")?.join(rel);
+    if !path.exists() {
+        stereocal_hil::skip("rtl_real_images", &format!("{} not found", path.display()));
         return None;
     }
+    let path = path.display().to_string();
     let img = image::open(&path).expect("real image decodes").into_luma8();
     let (iw, ih) = (img.width() as usize, img.height() as usize);
     assert!(iw >= w && ih >= h, "{path} smaller than the crop");
