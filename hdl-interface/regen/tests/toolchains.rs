@@ -226,7 +226,9 @@ fn register_block_testbench_passes() {
         .join("tb/sc_regs_tb.v");
     let out = scratch("sc_regs_tb").join("sc_regs_tb.vvp");
     run(Command::new("iverilog")
-        .args(["-g2005", "-Wall", "-s", "sc_regs_tb", "-o"])
+        .args(["-g2005", "-Wall", "-I"])
+        .arg(tb.parent().expect("tb has a directory"))
+        .args(["-s", "sc_regs_tb", "-o"])
         .arg(&out)
         .arg(&rtl)
         .arg(&tb));

@@ -162,24 +162,7 @@ module sc_fabric_tb;
 
     // ---------------------------------------------------------------------------------------
     // Bus cycles.
-    task write(input [7:0] addr, input [31:0] data);
-        begin
-            @(negedge clk);
-            bus_addr = addr; bus_wdata = data; bus_we = 1'b1;
-            @(negedge clk);
-            bus_we = 1'b0; bus_wdata = 32'h0;
-        end
-    endtask
-
-    task read(input [7:0] addr, output [31:0] data);
-        begin
-            @(negedge clk);
-            bus_addr = addr; bus_re = 1'b1;
-            @(negedge clk);
-            bus_re = 1'b0;
-            data = bus_rdata;
-        end
-    endtask
+`include "tb_bus.vh"
 
     reg [31:0] v;
     integer points_read, sobel_read;

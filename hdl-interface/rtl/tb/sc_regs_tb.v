@@ -92,24 +92,7 @@ module sc_regs_tb;
     endtask
 
     // One-clock bus cycles, driven between edges.
-    task write(input [7:0] addr, input [31:0] data);
-        begin
-            @(negedge clk);
-            bus_addr = addr; bus_wdata = data; bus_we = 1'b1;
-            @(negedge clk);
-            bus_we = 1'b0; bus_wdata = 32'h0;
-        end
-    endtask
-
-    task read(input [7:0] addr, output [31:0] data);
-        begin
-            @(negedge clk);
-            bus_addr = addr; bus_re = 1'b1;
-            @(negedge clk);
-            bus_re = 1'b0;
-            data = bus_rdata;
-        end
-    endtask
+`include "tb_bus.vh"
 
     task expect_read(input [255:0] what, input [7:0] addr, input [31:0] want);
         reg [31:0] v;
