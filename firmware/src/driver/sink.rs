@@ -39,17 +39,6 @@ impl<S: ByteSink> PacketWriter<S> {
         }
     }
 
-    /// A writer whose first packet gets sequence number `next_seq`: a stretch of a link's
-    /// numbering written apart from the rest (the host's in-process link runs the left camera
-    /// on one core while the right one runs on the other).
-    pub const fn continuing_at(sink: S, next_seq: u16) -> Self {
-        Self {
-            sink,
-            next_seq,
-            frame: [0; MAX_FRAME_LEN],
-        }
-    }
-
     /// Encodes `packet` with the next sequence number and writes the frame to the sink.
     ///
     /// The sequence number is used up only when the packet was encoded, so a refused packet
@@ -61,8 +50,9 @@ impl<S: ByteSink> PacketWriter<S> {
         Ok(())
     }
 
-    /// Makes `seq` the next packet's sequence number (after a stretch of the numbering was
-    /// written by a [`Self::continuing_at`] writer).
+    /// Makes `seq` the next packet's sequence number: a stretch of a link's numbering can be
+    /// written apart from the rest (the host's in-process link runs the left camera on one
+    /// core while the right one runs on the other) and the link's writer then skips past it.
     pub fn set_next_seq(&mut self, seq: u16) {
         self.next_seq = seq;
     }

@@ -123,7 +123,8 @@ impl InProcessLink {
         let (left_channel, right_channel) = (&mut self.left, &mut self.right);
         let ((left_result, left_out), (right_result, right_out)) = rayon::join(
             || {
-                let mut out = PacketWriter::continuing_at(Outbox::default(), start);
+                let mut out = PacketWriter::new(Outbox::default());
+                out.set_next_seq(start);
                 let result = left_channel.process_frame(left, timestamp_us, &mut out);
                 (result, out)
             },
