@@ -3,12 +3,27 @@
 //! A verge head spends most of its time still and now and then turns fast, and one
 //! constant-velocity filter cannot serve both: tuned still, it lags and overshoots every move;
 //! tuned for moves, it passes the measurement noise of a still head straight through. So two
-//! constant-velocity models run side by side in an interacting multiple model (IMM) filter:
-//! *still* (tiny acceleration noise) and *turning* (large), with Markov switching between them.
-//! Each frame the models are mixed, predicted, updated, and weighted by how well each predicted
-//! the measurement; the output is their mixture. State `[verge, rate]` in degrees and degrees
-//! per second; prediction and uncertainty grow with the real time between frames (`dt` from the
+//! models run side by side in an interacting multiple model (IMM) filter, with Markov switching
+//! between them: *still*, a constant verge (the rate held at zero, a slow random walk for
+//! drift), and *turning*, constant velocity with large acceleration noise. Each frame the
+//! models are mixed, predicted, updated, and weighted by how well each predicted the
+//! measurement; the output is their mixture. State `[verge, rate]` in degrees and degrees per
+//! second; prediction and uncertainty grow with the real time between frames (`dt` from the
 //! timestamps, not a frame count).
+//!
+//! Why the still model has no rate: a still head's rate is zero, and a still model that keeps
+//! one (constant velocity with small noise) fits a line through the last few measurements, so
+//! it follows any error that persists for a few frames. On real frames the per-frame error is
+//! such a slowly changing function of the view (a head on a moving vehicle sees the scene
+//! drift); holding the rate at zero averages it over as many frames as the drift density
+//! allows (on the injected-verge terrace sequence the fixed-camera span fell from 0.067° to
+//! under 0.03°).
+//!
+//! Why the models are weighed by a Student-t likelihood rather than a Gaussian: the per-frame
+//! errors have heavier tails than the estimator's σ says (a 3-4 σ frame every few dozen), and
+//! under a Gaussian one such frame makes the turning model a hundred times likelier, so the
+//! output jumps with it. A t-distribution with a few degrees of freedom takes several
+//! consistent frames to switch, which a real move gives at once.
 //!
 //! A measurement whose innovation exceeds `gate_sigmas` standard deviations of even the turning
 //! model's prediction is rejected (a bad frame must not pull the estimate); after
@@ -22,7 +37,7 @@ use nalgebra::{Matrix2, Vector2};
 /// Filter settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KalmanConfig {
-    /// Spectral density of the verge acceleration noise of the still model, deg²/s³.
+    /// Spectral density of the still model's verge random walk (slow drift), deg²/s.
     pub still_noise: f64,
     /// Spectral density of the verge acceleration noise of the turning model, deg²/s³.
     pub turning_noise: f64,
@@ -36,18 +51,23 @@ pub struct KalmanConfig {
     pub initial_rate_sigma: f64,
     /// Consecutive rejected measurements after which the filter restarts.
     pub reset_after_rejections: usize,
+    /// Degrees of freedom of the Student-t innovation likelihood that weighs the two models
+    /// (`f64::INFINITY`: Gaussian).
+    pub likelihood_dof: f64,
 }
 
 impl Default for KalmanConfig {
     fn default() -> Self {
         Self {
-            still_noise: 1e-4,
+            // 0.01° of drift in 10 s.
+            still_noise: 1e-5,
             turning_noise: 100.0,
             mode_time_s: 2.0,
             min_measurement_sigma_deg: 0.01,
             gate_sigmas: 5.0,
             initial_rate_sigma: 10.0,
             reset_after_rejections: 2,
+            likelihood_dof: 8.0,
         }
     }
 }
@@ -172,7 +192,7 @@ impl VergeFilter {
             let innovation = m.verge_deg - wide.x[0];
             let wide_var = wide.p[(0, 0)] + r;
             if innovation * innovation <= self.config.gate_sigmas.powi(2) * wide_var {
-                next = update(&predicted, m.verge_deg, r);
+                next = update(&predicted, m.verge_deg, r, self.config.likelihood_dof);
                 self.rejections = 0;
                 self.last_rejected = None;
                 status = FilterStatus::Updated;
@@ -189,7 +209,8 @@ impl VergeFilter {
         Ok(Some(output(&next, status)))
     }
 
-    /// IMM mixing and constant-velocity prediction of both models over `dt` seconds.
+    /// IMM mixing and the prediction of both models over `dt` seconds: constant verge for the
+    /// still model, constant rate for the turning one.
     fn predict(&self, s: &State, dt: f64) -> State {
         // Probability of switching mode within dt, from the mean time in a mode.
         let switch = if self.config.mode_time_s > 0.0 {
@@ -203,7 +224,6 @@ impl VergeFilter {
         for (j, mu_j) in mu.iter_mut().enumerate() {
             *mu_j = (0..2).map(|i| transition[i][j] * s.mu[i]).sum();
         }
-        let f = Matrix2::new(1.0, dt, 0.0, 1.0);
         let mut models = s.models;
         for (j, model) in models.iter_mut().enumerate() {
             // Mixed prior of model j: the models' estimates weighted by P(was i | is j).
@@ -220,17 +240,23 @@ impl VergeFilter {
                 let d = m.x - x0;
                 p0 += (m.p + d * d.transpose()) * wi;
             }
-            let q = if j == STILL {
-                self.config.still_noise
+            let (f, qm) = if j == STILL {
+                // The rate is zero, not merely unknown: its variance is zero too.
+                let q = self.config.still_noise;
+                (
+                    Matrix2::new(1.0, 0.0, 0.0, 0.0),
+                    Matrix2::new(q * dt, 0.0, 0.0, 0.0),
+                )
             } else {
-                self.config.turning_noise
+                let q = self.config.turning_noise;
+                let qm = Matrix2::new(
+                    q * dt.powi(3) / 3.0,
+                    q * dt * dt / 2.0,
+                    q * dt * dt / 2.0,
+                    q * dt,
+                );
+                (Matrix2::new(1.0, dt, 0.0, 1.0), qm)
             };
-            let qm = Matrix2::new(
-                q * dt.powi(3) / 3.0,
-                q * dt * dt / 2.0,
-                q * dt * dt / 2.0,
-                q * dt,
-            );
             *model = Gaussian {
                 x: f * x0,
                 p: f * p0 * f.transpose() + qm,
@@ -287,7 +313,7 @@ impl VergeFilter {
 
 /// Kalman update of both models with the verge measurement `z` (variance `r`), and the new
 /// model probabilities from each model's innovation likelihood.
-fn update(s: &State, z: f64, r: f64) -> State {
+fn update(s: &State, z: f64, r: f64, dof: f64) -> State {
     let mut out = *s;
     let mut weights = [0.0; 2];
     for (j, model) in out.models.iter_mut().enumerate() {
@@ -298,9 +324,7 @@ fn update(s: &State, z: f64, r: f64) -> State {
         let kh = Matrix2::new(k[0], 0.0, k[1], 0.0);
         model.p = (Matrix2::identity() - kh) * model.p;
         model.p = 0.5 * (model.p + model.p.transpose());
-        let likelihood = (-0.5 * innovation * innovation / var).exp()
-            / (2.0 * std::f64::consts::PI * var).sqrt();
-        weights[j] = likelihood * s.mu[j];
+        weights[j] = likelihood(innovation * innovation / var, dof) / var.sqrt() * s.mu[j];
     }
     let total = weights[STILL] + weights[TURNING];
     // Both likelihoods underflow only for a measurement far outside both predictions, which
@@ -309,6 +333,16 @@ fn update(s: &State, z: f64, r: f64) -> State {
         out.mu = [weights[STILL] / total, weights[TURNING] / total];
     }
     out
+}
+
+/// The density of a standardised innovation whose square is `z2`, up to a factor common to
+/// both models: Student-t with `dof` degrees of freedom, Gaussian when `dof` is infinite.
+fn likelihood(z2: f64, dof: f64) -> f64 {
+    if dof.is_finite() {
+        (1.0 + z2 / dof).powf(-0.5 * (dof + 1.0))
+    } else {
+        (-0.5 * z2).exp()
+    }
 }
 
 fn output(s: &State, status: FilterStatus) -> FilterOutput {
@@ -348,8 +382,14 @@ mod tests {
         let t = 59 * 33_333 + 500_000;
         let p = f.step(t, None).unwrap().unwrap();
         assert_eq!(p.status, FilterStatus::Predicted);
+        // The head may have stopped in the gap: the prediction mixes the still model's
+        // (where the ramp was) with the turning model's (along it), and its σ covers both.
         let truth = 1.0 + 2.0 * t as f64 * 1e-6;
-        assert!((p.verge_deg - truth).abs() < 0.1, "{p:?} vs {truth}");
+        assert!(p.verge_deg > o.verge_deg + 0.5, "{p:?} after {o:?}");
+        assert!(
+            (p.verge_deg - truth).abs() < p.sigma_deg,
+            "{p:?} vs {truth}"
+        );
         assert!(p.sigma_deg > o.sigma_deg);
     }
 
@@ -428,6 +468,43 @@ mod tests {
             }
         }
         assert!(hi - lo < 0.03, "span {}", hi - lo);
+    }
+
+    #[test]
+    fn fixed_cameras_average_out_an_error_that_persists_for_frames() {
+        // The per-frame error of real frames changes with the view: here ±0.02° that holds
+        // for a dozen frames at a time. A still model with a rate follows each plateau.
+        let mut f = VergeFilter::new(KalmanConfig::default());
+        let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+        for i in 0..240u64 {
+            let plateau = if (i / 12) % 2 == 0 { 0.02 } else { -0.02 };
+            let o = f.step(i * 33_333, meas(1.6 + plateau)).unwrap().unwrap();
+            if i >= 60 {
+                lo = lo.min(o.verge_deg);
+                hi = hi.max(o.verge_deg);
+            }
+        }
+        assert!(hi - lo < 0.015, "span {}", hi - lo);
+    }
+
+    #[test]
+    fn one_outlying_frame_does_not_switch_a_still_head_to_turning() {
+        let after_outlier = |likelihood_dof| {
+            let mut f = VergeFilter::new(KalmanConfig {
+                likelihood_dof,
+                ..KalmanConfig::default()
+            });
+            for i in 0..60u64 {
+                f.step(i * 33_333, meas(1.6)).unwrap();
+            }
+            // 4 σ of the measurement: inside the gate, more than a still head explains.
+            f.step(60 * 33_333, meas(1.68)).unwrap().unwrap()
+        };
+        let (t, gaussian) = (after_outlier(8.0), after_outlier(f64::INFINITY));
+        assert_eq!(t.status, FilterStatus::Updated);
+        assert!(t.turning_probability < 0.5, "{t:?}");
+        assert!(gaussian.turning_probability > 0.8, "{gaussian:?}");
+        assert!((t.verge_deg - 1.6).abs() < 0.5 * (gaussian.verge_deg - 1.6).abs());
     }
 
     #[test]
