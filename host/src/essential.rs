@@ -33,6 +33,8 @@ use crate::calib::Calibration;
 pub struct Correspondence {
     pub left: [f64; 2],
     pub right: [f64; 2],
+    /// Relative weight in the refinement (inverse variance, 1 = nominal).
+    pub weight: f64,
 }
 
 impl Correspondence {
@@ -43,6 +45,7 @@ impl Correspondence {
         Self {
             left: [xl, yl],
             right: [xr, yr],
+            weight: 1.0,
         }
     }
 
@@ -228,7 +231,11 @@ pub(crate) mod testutil {
             if l.iter().chain(r.iter()).any(|v| v.abs() > 0.6) {
                 continue;
             }
-            out.push(Correspondence { left: l, right: r });
+            out.push(Correspondence {
+                left: l,
+                right: r,
+                weight: 1.0,
+            });
         }
         out
     }

@@ -50,6 +50,15 @@ pub struct EstimatorConfig {
     pub min_matches: usize,
     /// Guided matching of the keypoints the descriptors left unmatched (needs Sobel planes).
     pub guided: Option<GuidedConfig>,
+    /// Weigh each refined match by the inverse variance of its vertical position,
+    /// `1 / max(σ_v, floor)²`, with this floor in pixels; `None`: every match alike.
+    ///
+    /// The verge lives in the vertical disparities, and the sub-pixel refinement knows how well
+    /// it placed each one vertically (σ_v spans a decade between a corner and a weak edge), so
+    /// equal weights let the vaguest matches add as much noise as the sharpest. σ_v is the
+    /// noise bound of one window, blind to the interpolation bias that stays at a few
+    /// hundredths of a pixel, so the floor keeps one sharp match from outweighing the rest.
+    pub weight_floor_px: Option<f32>,
 }
 
 /// Guided matching: every left keypoint without a descriptor match is searched for in the
@@ -87,6 +96,7 @@ impl Default for EstimatorConfig {
             model: Model::Constrained,
             min_matches: 12,
             guided: Some(GuidedConfig::default()),
+            weight_floor_px: Some(0.02),
         }
     }
 }
@@ -151,6 +161,16 @@ impl VergeEstimator {
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> (Vec<Match>, Vec<PixelPair>) {
+        let (matches, pairs) = self.refined_pairs(left, right);
+        (matches, pairs.into_iter().map(|(p, _)| p).collect())
+    }
+
+    /// [`VergeEstimator::point_pairs`] with each refined pair's vertical 1-σ (pixels).
+    fn refined_pairs(
+        &self,
+        left: &FeatureFrame,
+        right: &FeatureFrame,
+    ) -> (Vec<Match>, Vec<(PixelPair, Option<f32>)>) {
         // The two images and the matches are independent: both cores work on them.
         let (dl, dr) = rayon::join(
             || describe(left, &self.config.descriptor),
@@ -173,11 +193,17 @@ impl VergeEstimator {
                     (Some(cfg), Some((pl, pr))) => {
                         let r = refine_pair(pl, pr, [kl.x, kl.y], [kr.x, kr.y], &cfg)?;
                         Some((
-                            [r.left[0] as f64, r.left[1] as f64],
-                            [r.right[0] as f64, r.right[1] as f64],
+                            (
+                                [r.left[0] as f64, r.left[1] as f64],
+                                [r.right[0] as f64, r.right[1] as f64],
+                            ),
+                            Some(r.sigma_v),
                         ))
                     }
-                    _ => Some(([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64])),
+                    _ => Some((
+                        ([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64]),
+                        None,
+                    )),
                 }
             })
             .collect();
@@ -190,7 +216,7 @@ impl VergeEstimator {
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> Result<FrameEstimate, EstimateError> {
-        let (matches, mut pairs) = self.point_pairs(left, right);
+        let (matches, mut pairs) = self.refined_pairs(left, right);
         if let (Some(g), Some(sub), Some(pl), Some(pr)) = (
             self.config.guided,
             self.config.subpixel,
@@ -200,7 +226,9 @@ impl VergeEstimator {
             let extra = guided_pairs(left, &matches, &pairs, pl, pr, &g, &sub);
             pairs.extend(extra);
         }
-        let mut est = self.estimate_from_pixels(&pairs)?;
+        let weights = match_weights(&pairs, self.config.weight_floor_px);
+        let pairs: Vec<PixelPair> = pairs.into_iter().map(|(p, _)| p).collect();
+        let mut est = self.estimate_weighted(&pairs, &weights)?;
         est.matches = matches.len();
         let keypoints = left.keypoints();
         est.keypoints_per_octave = per_octave(keypoints.iter().map(|k| k.octave));
@@ -214,6 +242,14 @@ impl VergeEstimator {
         &self,
         pairs: &[PixelPair],
     ) -> Result<FrameEstimate, EstimateError> {
+        self.estimate_weighted(pairs, &vec![1.0; pairs.len()])
+    }
+
+    fn estimate_weighted(
+        &self,
+        pairs: &[PixelPair],
+        weights: &[f64],
+    ) -> Result<FrameEstimate, EstimateError> {
         let need = self.config.min_matches;
         if pairs.len() < need {
             return Err(EstimateError::TooFewMatches {
@@ -223,7 +259,11 @@ impl VergeEstimator {
         }
         let corr: Vec<Correspondence> = pairs
             .iter()
-            .map(|(l, r)| Correspondence::from_pixels(&self.calib, *l, *r))
+            .zip(weights)
+            .map(|((l, r), w)| Correspondence {
+                weight: *w,
+                ..Correspondence::from_pixels(&self.calib, *l, *r)
+            })
             .collect();
         let focal = 0.5 * (self.calib.left.focal_px() + self.calib.right.focal_px());
         let init = match self.config.ransac {
@@ -288,6 +328,23 @@ impl VergeEstimator {
     }
 }
 
+/// The refinement weight of each pair (see [`EstimatorConfig::weight_floor_px`]), scaled so
+/// that the median weight is 1: the robust scale of the residuals, and with it the refinement's
+/// residual floor and inlier limit, keep their meaning in pixels of a typical match.
+fn match_weights(pairs: &[(PixelPair, Option<f32>)], floor_px: Option<f32>) -> Vec<f64> {
+    let weights: Vec<f64> = pairs
+        .iter()
+        .map(|(_, sigma)| match (sigma, floor_px) {
+            (Some(s), Some(floor)) => 1.0 / f64::from(s.max(floor)).powi(2),
+            _ => 1.0,
+        })
+        .collect();
+    let mut sorted = weights.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(1.0);
+    weights.iter().map(|w| w / median).collect()
+}
+
 /// How many of `octaves` fall in each octave: at least the fabric's maximum octave count long,
 /// so frames line up, and longer if a frame carries a higher octave.
 fn per_octave(octaves: impl Iterator<Item = u8>) -> Vec<usize> {
@@ -305,12 +362,12 @@ fn per_octave(octaves: impl Iterator<Item = u8>) -> Vec<usize> {
 fn guided_pairs(
     left: &FeatureFrame,
     matches: &[Match],
-    pairs: &[PixelPair],
+    pairs: &[(PixelPair, Option<f32>)],
     pl: &SobelPlane,
     pr: &SobelPlane,
     g: &GuidedConfig,
     sub: &SubpixelConfig,
-) -> Vec<PixelPair> {
+) -> Vec<(PixelPair, Option<f32>)> {
     if pairs.len() < g.neighbours {
         return Vec::new();
     }
@@ -322,7 +379,7 @@ fn guided_pairs(
     let mut near: Vec<(f32, usize)> = Vec::with_capacity(pairs.len());
     let mut taken: Vec<[f32; 2]> = pairs
         .iter()
-        .map(|(l, _)| [l[0] as f32, l[1] as f32])
+        .map(|((l, _), _)| [l[0] as f32, l[1] as f32])
         .collect();
     let mut out = Vec::new();
     for (k, kp) in left.keypoints().iter().enumerate() {
@@ -337,7 +394,7 @@ fn guided_pairs(
             continue;
         }
         near.clear();
-        near.extend(pairs.iter().enumerate().filter_map(|(i, (l, _))| {
+        near.extend(pairs.iter().enumerate().filter_map(|(i, ((l, _), _))| {
             let d2 = (l[0] as f32 - kp.x).powi(2) + (l[1] as f32 - kp.y).powi(2);
             (d2 <= max_d2).then_some((d2, i))
         }));
@@ -347,11 +404,11 @@ fn guided_pairs(
         near.select_nth_unstable_by(g.neighbours - 1, |a, b| a.0.total_cmp(&b.0));
         let mut du: Vec<f32> = near[..g.neighbours]
             .iter()
-            .map(|&(_, i)| (pairs[i].1[0] - pairs[i].0[0]) as f32)
+            .map(|&(_, i)| (pairs[i].0 .1[0] - pairs[i].0 .0[0]) as f32)
             .collect();
         let mut dv: Vec<f32> = near[..g.neighbours]
             .iter()
-            .map(|&(_, i)| (pairs[i].1[1] - pairs[i].0[1]) as f32)
+            .map(|&(_, i)| (pairs[i].0 .1[1] - pairs[i].0 .0[1]) as f32)
             .collect();
         du.sort_by(f32::total_cmp);
         dv.sort_by(f32::total_cmp);
@@ -359,8 +416,11 @@ fn guided_pairs(
         if let Some(r) = guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, sub) {
             taken.push(r.left);
             out.push((
-                [r.left[0] as f64, r.left[1] as f64],
-                [r.right[0] as f64, r.right[1] as f64],
+                (
+                    [r.left[0] as f64, r.left[1] as f64],
+                    [r.right[0] as f64, r.right[1] as f64],
+                ),
+                Some(r.sigma_v),
             ));
         }
     }

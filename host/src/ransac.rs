@@ -271,6 +271,7 @@ mod tests {
         let c = Correspondence {
             left: [0.0, 0.1],
             right: [0.0, 0.1],
+            weight: 1.0,
         };
         assert!(matches!(
             ransac(&[c], &RansacConfig::default()),

@@ -147,14 +147,15 @@ pub fn refine(
             (plus - minus) / (2.0 * STEP)
         });
         for (r, c) in residuals.iter_mut().zip(matches) {
-            *r = sampson_residual(&e, c);
+            *r = sampson_residual(&e, c) * c.weight.sqrt();
         }
         sigma = mad_sigma(&residuals, config.min_sigma);
         let mut h = SMatrix::<f64, 5, 5>::zeros();
         let mut b = SVector::<f64, 5>::zeros();
         for (c, r) in matches.iter().zip(&residuals) {
             // The Sampson residual is linear in E to first order: differentiate through E.
-            let g = SVector::<f64, 5>::from_fn(|k, _| sampson_derivative(&e, &de[k], c));
+            let g = SVector::<f64, 5>::from_fn(|k, _| sampson_derivative(&e, &de[k], c))
+                * c.weight.sqrt();
             let w = config.loss.weight(*r, sigma);
             h += w * g * g.transpose();
             b += w * g * *r;
@@ -186,7 +187,7 @@ pub fn refine(
     let limit = config.inlier_sigmas * sigma;
     let inliers = matches
         .iter()
-        .map(|c| sampson_residual(&e, c).abs() < limit)
+        .map(|c| sampson_residual(&e, c).abs() * c.weight.sqrt() < limit)
         .collect();
     Ok(GeneralFit {
         pose,
