@@ -155,18 +155,9 @@ impl VergeEstimator {
     }
 
     /// Matches two frames and returns the matched full-resolution point pairs, refined to
-    /// sub-pixel precision when configured and possible.
-    pub fn point_pairs(
-        &self,
-        left: &FeatureFrame,
-        right: &FeatureFrame,
-    ) -> (Vec<Match>, Vec<PixelPair>) {
-        let (matches, pairs) = self.refined_pairs(left, right);
-        (matches, pairs.into_iter().map(|(p, _)| p).collect())
-    }
-
-    /// [`VergeEstimator::point_pairs`] with each refined pair's vertical 1-σ (pixels).
-    fn refined_pairs(
+    /// sub-pixel precision when configured and possible, each with its vertical 1-σ in pixels
+    /// when refined.
+    fn point_pairs(
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
@@ -216,7 +207,7 @@ impl VergeEstimator {
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> Result<FrameEstimate, EstimateError> {
-        let (matches, mut pairs) = self.refined_pairs(left, right);
+        let (matches, mut pairs) = self.point_pairs(left, right);
         if let (Some(g), Some(sub), Some(pl), Some(pr)) = (
             self.config.guided,
             self.config.subpixel,
