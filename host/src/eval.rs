@@ -94,13 +94,19 @@ pub fn evaluate_frames<D: Device>(
             .images
             .as_ref()
             .map(|i| (i.left.as_raw().as_slice(), i.right.as_raw().as_slice()));
-        let record = session.process(
+        let record = session.submit(
             frame.index,
             images,
             (width as usize, height as usize),
             frame.timestamp_us,
             Some(frame.truth.verge_deg),
         )?;
+        if let Some(record) = record {
+            progress(&record);
+            records.push(record);
+        }
+    }
+    while let Some(record) = session.flush()? {
         progress(&record);
         records.push(record);
     }

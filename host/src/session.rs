@@ -7,6 +7,7 @@
 //! wire format. The device is the in-process one unless [`Session::with_device`] is given
 //! another (`stereocal hil` gives it the firmware under QEMU).
 
+use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use stereocal_hdl::regs::output_mode::SobelOutput;
@@ -16,7 +17,7 @@ use crate::calib::Calibration;
 use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome};
 use crate::estimator::{EstimatorConfig, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
-use crate::link::{Device, InProcessLink, LinkError};
+use crate::link::{Device, InProcessLink, LinkError, Threaded};
 use crate::record::{FrameRecord, FrameStatus};
 use crate::summary::RunCost;
 
@@ -136,8 +137,24 @@ impl SessionCost {
     }
 }
 
+/// A pair handed to the device whose record is not out yet.
+#[derive(Debug, Clone, Copy)]
+struct InFlight {
+    frame: usize,
+    /// Whether images went to the device (a pair the grabber lost did not).
+    submitted: bool,
+    timestamp_us: u64,
+    truth_deg: Option<f64>,
+}
+
 /// One stereo head, from pixels to filtered verge angle, on device `D`.
-pub struct Session<D: Device = InProcessLink> {
+///
+/// Pairs go in with [`Session::submit`] and records come out in the same order. A device with
+/// a [`lookahead`](Device::lookahead) works on the next pairs while the host decodes and
+/// estimates the oldest, so `submit` returns a record only once more pairs are in flight than
+/// the device takes ahead, and [`Session::flush`] collects the rest; [`Session::process`] is
+/// one pair in, its record out.
+pub struct Session<D: Device = Threaded> {
     driver: Driver<D>,
     fabric: FabricConfig,
     estimator: VergeEstimator,
@@ -145,11 +162,13 @@ pub struct Session<D: Device = InProcessLink> {
     /// The device's id of the next pair submitted: it numbers frames from 0 after it starts
     /// (the firmware driver's channel), one per pair.
     next_frame_id: u32,
+    in_flight: VecDeque<InFlight>,
     cost: SessionCost,
 }
 
 impl Session {
-    /// Opens the in-process device, says Hello, configures the fabric for `width` x `height`
+    /// Opens the in-process device in a thread of its own (it works on the next pair while
+    /// the host estimates the last), says Hello, configures the fabric for `width` x `height`
     /// and reads the registers back.
     pub fn new(
         calib: Calibration,
@@ -157,7 +176,8 @@ impl Session {
         height: u16,
         config: SessionConfig,
     ) -> Result<Self, SessionError> {
-        Self::with_device(InProcessLink::new()?, calib, width, height, config)
+        let device = Threaded::new(InProcessLink::new()?, "in-process")?;
+        Self::with_device(device, calib, width, height, config)
     }
 }
 
@@ -183,6 +203,7 @@ impl<D: Device> Session<D> {
             estimator: VergeEstimator::new(calib, config.estimator),
             filter: VergeFilter::new(config.kalman),
             next_frame_id: 0,
+            in_flight: VecDeque::new(),
             cost: SessionCost::default(),
         })
     }
@@ -202,9 +223,11 @@ impl<D: Device> Session<D> {
         self.cost
     }
 
-    /// Processes frame pair `frame` captured at `timestamp_us`. `images` is `None` for a pair
-    /// the grabber lost: the filter predicts across it and the record says `dropped`.
-    /// A pair damaged on the link is dropped the same way, never estimated.
+    /// Processes frame pair `frame` captured at `timestamp_us` and returns the oldest record
+    /// in flight: this pair's own when it is the only one (the caller did not
+    /// [`submit`](Session::submit) ahead). `images` is `None` for a pair the grabber lost: the
+    /// filter predicts across it and the record says `dropped`. A pair damaged on the link is
+    /// dropped the same way, never estimated.
     pub fn process(
         &mut self,
         frame: usize,
@@ -213,7 +236,73 @@ impl<D: Device> Session<D> {
         timestamp_us: u64,
         truth_deg: Option<f64>,
     ) -> Result<FrameRecord, SessionError> {
+        let pair = self.start(frame, images, image_size, timestamp_us, truth_deg)?;
+        self.in_flight.push_back(pair);
+        let oldest = self.in_flight.pop_front().unwrap_or(pair);
+        self.finish(oldest)
+    }
+
+    /// Hands pair `frame` to the device (see [`Session::process`] for the arguments) and
+    /// returns the oldest record once more pairs are in flight than the device works ahead.
+    pub fn submit(
+        &mut self,
+        frame: usize,
+        images: Option<(&[u8], &[u8])>,
+        image_size: (usize, usize),
+        timestamp_us: u64,
+        truth_deg: Option<f64>,
+    ) -> Result<Option<FrameRecord>, SessionError> {
+        let pair = self.start(frame, images, image_size, timestamp_us, truth_deg)?;
+        self.in_flight.push_back(pair);
+        if self.in_flight.len() > self.driver.link().lookahead() {
+            self.flush()
+        } else {
+            Ok(None)
+        }
+    }
+
+    /// The record of the oldest pair in flight; `None` when there is none.
+    pub fn flush(&mut self) -> Result<Option<FrameRecord>, SessionError> {
+        match self.in_flight.pop_front() {
+            Some(pair) => self.finish(pair).map(Some),
+            None => Ok(None),
+        }
+    }
+
+    /// Hands the images, if any, to the device.
+    fn start(
+        &mut self,
+        frame: usize,
+        images: Option<(&[u8], &[u8])>,
+        image_size: (usize, usize),
+        timestamp_us: u64,
+        truth_deg: Option<f64>,
+    ) -> Result<InFlight, SessionError> {
         let start = Instant::now();
+        if let Some((left, right)) = images {
+            self.check_size(frame, image_size)?;
+            self.driver
+                .link_mut()
+                .submit_pair(left, right, timestamp_us)?;
+        }
+        self.cost.elapsed += start.elapsed();
+        Ok(InFlight {
+            frame,
+            submitted: images.is_some(),
+            timestamp_us,
+            truth_deg,
+        })
+    }
+
+    /// Reads the pair back, estimates and filters it.
+    fn finish(&mut self, pair: InFlight) -> Result<FrameRecord, SessionError> {
+        let start = Instant::now();
+        let InFlight {
+            frame,
+            submitted,
+            timestamp_us,
+            truth_deg,
+        } = pair;
         let mut record = FrameRecord {
             frame,
             raw_verge_deg: None,
@@ -226,41 +315,36 @@ impl<D: Device> Session<D> {
             status: FrameStatus::Dropped,
             truth_deg,
         };
-        let measurement = match images {
-            None => None,
-            Some((left, right)) => {
-                self.check_size(frame, image_size)?;
-                self.driver
-                    .link_mut()
-                    .submit_pair(left, right, timestamp_us)?;
-                match self.receive_pair(frame)? {
-                    Some(PairOutcome::Pair {
-                        left: FrameOutcome::Delivered(left),
-                        right: FrameOutcome::Delivered(right),
-                    }) => {
-                        record.status = FrameStatus::NoEstimate;
-                        let estimating = Instant::now();
-                        let estimate = self.estimator.estimate(&left.features, &right.features);
-                        self.cost.estimating += estimating.elapsed();
-                        match estimate {
-                            Ok(est) => {
-                                record.raw_verge_deg = Some(est.verge_deg);
-                                record.matches = est.matches;
-                                record.inliers = est.inliers;
-                                record.keypoints_per_octave = est.keypoints_per_octave;
-                                record.matches_per_octave = est.matches_per_octave;
-                                record.status = FrameStatus::Ok;
-                                Some(Measurement {
-                                    verge_deg: est.verge_deg,
-                                    sigma_deg: est.sigma_deg,
-                                })
-                            }
-                            Err(_) => None,
+        let measurement = if submitted {
+            match self.receive_pair(frame)? {
+                Some(PairOutcome::Pair {
+                    left: FrameOutcome::Delivered(left),
+                    right: FrameOutcome::Delivered(right),
+                }) => {
+                    record.status = FrameStatus::NoEstimate;
+                    let estimating = Instant::now();
+                    let estimate = self.estimator.estimate(&left.features, &right.features);
+                    self.cost.estimating += estimating.elapsed();
+                    match estimate {
+                        Ok(est) => {
+                            record.raw_verge_deg = Some(est.verge_deg);
+                            record.matches = est.matches;
+                            record.inliers = est.inliers;
+                            record.keypoints_per_octave = est.keypoints_per_octave;
+                            record.matches_per_octave = est.matches_per_octave;
+                            record.status = FrameStatus::Ok;
+                            Some(Measurement {
+                                verge_deg: est.verge_deg,
+                                sigma_deg: est.sigma_deg,
+                            })
                         }
+                        Err(_) => None,
                     }
-                    Some(_) | None => None,
                 }
+                Some(_) | None => None,
             }
+        } else {
+            None
         };
         let filtered = self
             .filter

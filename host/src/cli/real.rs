@@ -116,13 +116,19 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         let mut records = Vec::with_capacity(sequence.len());
         for (frame, pair) in rx.into_iter().enumerate() {
             let (l, r) = pair?;
-            let record = session.process(
+            let record = session.submit(
                 frame,
                 Some((&l.pixels, &r.pixels)),
                 window,
                 (frame as f64 * period_us).round() as u64,
                 truth.as_ref().map(|t| t[frame]),
             )?;
+            if let Some(record) = record {
+                bar.inc(1);
+                records.push(record);
+            }
+        }
+        while let Some(record) = session.flush()? {
             bar.inc(1);
             records.push(record);
         }

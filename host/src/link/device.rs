@@ -26,6 +26,13 @@ pub trait Device: Link {
 
     /// How long the host waits for one answer or one frame pair from this device.
     fn answer_timeout(&self) -> Duration;
+
+    /// Pairs a session may submit beyond the one whose packets it is waiting for: 0 for a
+    /// device that computes a pair only while the host waits for it, more for one that works
+    /// on its own ([`Threaded`](super::Threaded)).
+    fn lookahead(&self) -> usize {
+        0
+    }
 }
 
 /// A borrowed device is a device: the caller keeps it, e.g. to stop an emulator and read its
@@ -42,6 +49,10 @@ impl<D: Device + ?Sized> Device for &mut D {
 
     fn answer_timeout(&self) -> Duration {
         (**self).answer_timeout()
+    }
+
+    fn lookahead(&self) -> usize {
+        (**self).lookahead()
     }
 }
 

@@ -9,6 +9,7 @@
 //! | transport | type | constructor |
 //! |---|---|---|
 //! | fabric model + soft-core driver inside the host | [`InProcessLink`] | [`InProcessLink::new`] |
+//! | any such device in a thread of its own, working ahead of the host | [`Threaded`] | [`Threaded::new`] |
 //! | serial port (UART of a real board) | [`SerialLink`] | [`StreamLink::serial`] |
 //! | TCP (QEMU `-chardev socket,host=..,port=..`) | [`TcpLink`] | [`StreamLink::tcp`] |
 //! | Unix socket (QEMU `-chardev socket,path=..`) | [`UnixLink`] | [`StreamLink::unix`] |
@@ -27,6 +28,7 @@ mod replay;
 mod serial;
 mod stream;
 mod tcp;
+mod threaded;
 #[cfg(unix)]
 mod unix;
 
@@ -41,6 +43,7 @@ pub use replay::ReplayLink;
 pub use serial::SerialLink;
 pub use stream::{StreamLink, TimedStream};
 pub use tcp::TcpLink;
+pub use threaded::Threaded;
 #[cfg(unix)]
 pub use unix::UnixLink;
 

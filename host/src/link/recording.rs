@@ -61,6 +61,10 @@ impl<D: Device> Device for Recording<D> {
     fn answer_timeout(&self) -> Duration {
         self.inner.answer_timeout()
     }
+
+    fn lookahead(&self) -> usize {
+        self.inner.lookahead()
+    }
 }
 
 #[cfg(test)]
