@@ -6,7 +6,9 @@
 //! batches), placed on its point's octave pixel.
 
 use stereocal_firmware::fabric::geometry::octave_dims;
-use stereocal_wire::{Point, SobelPatchRepr, SobelRowsRepr, PATCH_PIXELS};
+use stereocal_wire::{
+    Point, Record, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, PATCH_PIXELS,
+};
 
 use super::damage::ContentError;
 use crate::frame::{FrameError, Gradients, Keypoint, SobelPatch, SobelPlane};
@@ -127,9 +129,27 @@ impl GradientBuilder {
         let end = start + usize::from(plane.width);
         let mag = &mut plane.magnitude[start..end];
         let ori = &mut plane.orientation[start..end];
-        for ((m, o), px) in mag.iter_mut().zip(ori.iter_mut()).zip(row.pixels.iter()) {
-            *m = px.magnitude;
-            *o = px.orientation;
+        match row.pixels {
+            // As decoded from the wire: split the interleaved bytes in one pass the compiler
+            // can vectorise (the full-Sobel stream is most of what a host decodes).
+            Records::Wire(bytes) => {
+                for ((m, o), px) in mag
+                    .iter_mut()
+                    .zip(ori.iter_mut())
+                    .zip(bytes.chunks_exact(SobelPixel::LEN))
+                {
+                    if let [magnitude, orientation] = *px {
+                        *m = magnitude;
+                        *o = orientation;
+                    }
+                }
+            }
+            Records::Values(pixels) => {
+                for ((m, o), px) in mag.iter_mut().zip(ori.iter_mut()).zip(pixels) {
+                    *m = px.magnitude;
+                    *o = px.orientation;
+                }
+            }
         }
         Ok(())
     }
