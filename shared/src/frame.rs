@@ -4,8 +4,7 @@
 //! receiver that lost sync (a dropped byte, line noise, a reset peer) is back in step at the
 //! next `0x00`. The overhead is one byte per 254 bytes plus one, and the delimiter.
 
-use cobs::{EncoderState, PushResult};
-
+use crate::cobs_in_place;
 use crate::packet::header::{self, Header, CRC_LEN, HEADER_LEN};
 use crate::packet_repr::PacketRepr;
 use crate::{Error, MAX_PAYLOAD_LEN, PROTOCOL_VERSION, SUPPORTED_VERSIONS};
@@ -24,8 +23,10 @@ pub const fn max_frame_len(payload_len: usize) -> usize {
 ///
 /// `out` must hold [`max_frame_len`]`(repr.buffer_len())` bytes (at most
 /// [`MAX_FRAME_LEN`](crate::MAX_FRAME_LEN)), even when the frame turns out shorter: the packet
-/// is first written at the end of `out` and then COBS-encoded in place towards the front,
-/// so no second buffer is needed on the soft-core.
+/// is first written one byte in, behind the slot of the first COBS code byte, and then
+/// COBS-encoded in place, so no second buffer is needed on the soft-core. Mostly that only
+/// rewrites its zeros; a packet with full COBS blocks (254 non-zero bytes) first moves one
+/// byte towards the end per such block, into the room the length check kept.
 pub fn encode<'o>(seq: u16, repr: &PacketRepr<'_>, out: &'o mut [u8]) -> Result<&'o [u8], Error> {
     let payload_len = repr.buffer_len();
     if payload_len > MAX_PAYLOAD_LEN {
@@ -35,7 +36,7 @@ pub fn encode<'o>(seq: u16, repr: &PacketRepr<'_>, out: &'o mut [u8]) -> Result<
         return Err(Error::EncodeBufferTooSmall);
     }
     let packet_len = HEADER_LEN + payload_len + CRC_LEN;
-    let offset = cobs::max_encoding_overhead(packet_len);
+    let offset = 1;
     let mut packet = header::Packet::new_unchecked(
         out.get_mut(offset..offset + packet_len)
             .ok_or(Error::EncodeBufferTooSmall)?,
@@ -51,54 +52,10 @@ pub fn encode<'o>(seq: u16, repr: &PacketRepr<'_>, out: &'o mut [u8]) -> Result<
     repr.emit(packet.payload_mut())?;
     packet.fill_crc();
     // `out` holds `max_frame_len` bytes (checked above), so neither `None` below happens.
-    let frame_len =
-        cobs_encode_in_place(out, offset, packet_len).ok_or(Error::EncodeBufferTooSmall)?;
+    let frame_len = cobs_in_place::encode_in_place(out, offset, packet_len)
+        .ok_or(Error::EncodeBufferTooSmall)?;
     *out.get_mut(frame_len).ok_or(Error::EncodeBufferTooSmall)? = DELIMITER;
     out.get(..=frame_len).ok_or(Error::EncodeBufferTooSmall)
-}
-
-/// COBS-encodes `buf[src..src + len]` into `buf[..]` and returns the encoded length, or
-/// `None` (before finishing) should `buf` be too short, which [`encode`] rules out.
-///
-/// The `cobs` crate's encoder state machine does the transform; this loop only moves bytes.
-/// It is safe in place when `src >= cobs::max_encoding_overhead(len)`: before input byte `i`
-/// is written, the output holds at most `i` bytes plus one code byte per started block, at
-/// most `1 + i / 254 <= src` extra bytes, so no unread input byte is overwritten.
-fn cobs_encode_in_place(buf: &mut [u8], src: usize, len: usize) -> Option<usize> {
-    let mut state = EncoderState::default();
-    // buf[0] is the first code byte, written once its block closes.
-    let mut dest = 1;
-    // After a full 254-byte block the next code byte's slot is only reserved if more bytes
-    // follow (COBS drops a final empty block after a full one).
-    let mut block_just_filled = false;
-    for i in src..src + len {
-        let byte = *buf.get(i)?;
-        if block_just_filled {
-            dest += 1;
-            block_just_filled = false;
-        }
-        match state.push(byte) {
-            PushResult::AddSingle(value) => {
-                *buf.get_mut(dest)? = value;
-                dest += 1;
-            }
-            PushResult::ModifyFromStartAndSkip((code_at, code)) => {
-                *buf.get_mut(code_at)? = code;
-                dest += 1;
-            }
-            PushResult::ModifyFromStartAndPushAndSkip((code_at, code, value)) => {
-                *buf.get_mut(code_at)? = code;
-                *buf.get_mut(dest)? = value;
-                dest += 1;
-                block_just_filled = true;
-            }
-        }
-    }
-    if !block_just_filled {
-        let (code_at, code) = state.finalize();
-        *buf.get_mut(code_at)? = code;
-    }
-    Some(dest)
 }
 
 /// Decodes one frame in place and parses it.
@@ -120,37 +77,9 @@ pub fn decode(frame: &mut [u8]) -> Result<(Header, PacketRepr<'_>), Error> {
     if encoded.contains(&DELIMITER) {
         return Err(Error::DecodeBadCobs);
     }
-    let packet_len = cobs_decode_in_place(encoded).ok_or(Error::DecodeBadCobs)?;
+    let packet = cobs_in_place::decode_in_place(encoded).ok_or(Error::DecodeBadCobs)?;
     let encoded: &[u8] = encoded;
-    parse_packet(encoded.get(..packet_len).ok_or(Error::DecodeBadCobs)?)
-}
-
-/// COBS-decodes `buf` (no `0x00` in it) in place and returns the decoded length, or `None`
-/// when a code byte points past the end. The same transform and the same rejections as
-/// `cobs::decode_in_place`, written with checked accesses so the firmware links no panic.
-fn cobs_decode_in_place(buf: &mut [u8]) -> Option<usize> {
-    let end = buf.len();
-    let mut src = 0;
-    let mut dest = 0;
-    while let Some(&code) = buf.get(src) {
-        let code = usize::from(code);
-        if src + code > end && code != 1 {
-            return None;
-        }
-        src += 1;
-        for _ in 1..code {
-            // `dest < src` throughout, so the write never overtakes the read.
-            let byte = *buf.get(src)?;
-            *buf.get_mut(dest)? = byte;
-            src += 1;
-            dest += 1;
-        }
-        if code != 0xff && src < end {
-            *buf.get_mut(dest)? = 0;
-            dest += 1;
-        }
-    }
-    Some(dest)
+    parse_packet(encoded.get(packet).ok_or(Error::DecodeBadCobs)?)
 }
 
 /// Checks and parses the bytes of a whole packet (after COBS decoding).
@@ -171,24 +100,4 @@ fn parse_packet(bytes: &[u8]) -> Result<(Header, PacketRepr<'_>), Error> {
         .ok_or(Error::DecodeUnexpectedEnd)?;
     let repr = PacketRepr::parse(header.kind, payload)?;
     Ok((header, repr))
-}
-
-#[cfg(test)]
-mod tests {
-    use proptest::prelude::*;
-
-    proptest! {
-        /// The checked in-place decoder agrees with the `cobs` crate on any zero-free input.
-        #[test]
-        fn cobs_decode_matches_the_cobs_crate(bytes in proptest::collection::vec(1u8..=255, 1..600)) {
-            let mut ours = bytes.clone();
-            let mut theirs = bytes;
-            let expected = cobs::decode_in_place(&mut theirs).ok();
-            let got = super::cobs_decode_in_place(&mut ours);
-            prop_assert_eq!(got, expected);
-            if let Some(len) = got {
-                prop_assert_eq!(&ours[..len], &theirs[..len]);
-            }
-        }
-    }
 }

@@ -62,6 +62,7 @@ pub mod packet;
 
 mod accumulator;
 mod checksum;
+mod cobs_in_place;
 mod error;
 mod frame;
 mod le;

@@ -14,7 +14,7 @@
 
 use crate::le::{self, Field};
 use crate::packet::camera::Camera;
-use crate::packet::sobel_pixel::{all_valid, SobelPixel};
+use crate::packet::sobel_pixel::{all_records_valid, all_valid, SobelPixel};
 use crate::packet::{check_fixed_len, check_room};
 use crate::records::{Record, Records};
 use crate::Error;
@@ -188,7 +188,7 @@ impl<'a> SobelPatchRepr<'a> {
         if self.pixels.len() != PATCH_PIXELS {
             return Err(Error::EncodeBadPatchSize);
         }
-        if !self.pixels.iter().all(|pixel| pixel.is_valid()) {
+        if !all_records_valid(&self.pixels) {
             return Err(Error::EncodeBadOrientation);
         }
         check_room(packet.buffer.as_ref().len(), self.buffer_len())?;
