@@ -16,22 +16,11 @@ pub type Cube = [[[i16; 3]; 3]; 3];
 pub fn is_extremum(c: &Cube, threshold: u16) -> bool {
     let v = c[1][1][1];
     let t = threshold as i32;
-    let is_max = v as i32 > t;
-    let is_min = (v as i32) < -t;
-    if !is_max && !is_min {
-        return false;
-    }
-    for (s, plane) in c.iter().enumerate() {
-        for (y, row) in plane.iter().enumerate() {
-            for (x, &n) in row.iter().enumerate() {
-                if (s, y, x) == (1, 1, 1) {
-                    continue;
-                }
-                if (is_max && n >= v) || (is_min && n <= v) {
-                    return false;
-                }
-            }
-        }
-    }
-    true
+    // The 26 neighbours are the flattened cube without its centre (index 13); their maximum
+    // and minimum decide both tests at once, with no data-dependent branch.
+    let all = c.as_flattened().as_flattened();
+    let (before, after) = all.split_at(13.min(all.len()));
+    let neighbours = before.iter().chain(after.iter().skip(1));
+    let (hi, lo) = neighbours.fold((i16::MIN, i16::MAX), |(hi, lo), &n| (hi.max(n), lo.min(n)));
+    (v as i32 > t && v > hi) || ((v as i32) < -t && v < lo)
 }

@@ -9,6 +9,8 @@ mod filter;
 mod frontend;
 mod octave;
 mod probe;
+#[cfg(target_arch = "x86_64")]
+mod simd;
 
 pub use filter::{column_filter, cordic_row, dog_row, row_filter, sobel_row};
 pub use frontend::FastFrontEnd;

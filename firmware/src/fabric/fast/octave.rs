@@ -251,44 +251,28 @@ impl<const W: usize> FastOctave<W> {
         }
         let yc = r - 1;
         let rows = [(r as usize - 2) % 3, (r as usize - 1) % 3, r as usize % 3];
-        let thr = self.config.contrast_threshold as i32;
-        for x in 1..w - 1 {
-            // Necessary conditions first (contrast, then the four direct neighbours), so the
-            // 26-neighbour test only runs on the few survivors; the verdict is unchanged.
-            let row = &self.dog[1][rows[1]];
-            let v = row[x] as i32;
-            let (l, r) = (row[x - 1] as i32, row[x + 1] as i32);
-            let (u, d) = (
-                self.dog[1][rows[0]][x] as i32,
-                self.dog[1][rows[2]][x] as i32,
-            );
-            let maybe = if v > thr {
-                l < v && r < v && u < v && d < v
-            } else if v < -thr {
-                l > v && r > v && u > v && d > v
-            } else {
-                false
-            };
-            if !maybe {
-                continue;
+        let (thr, edge_ratio, max_offset) = (
+            self.config.contrast_threshold,
+            self.config.edge_ratio,
+            self.config.max_offset,
+        );
+        // `get`, not indexing: the ring slots are below 3 and `w <= W`, but the optimiser
+        // cannot see that through the maps, and the firmware must link no panic.
+        let planes = self
+            .dog
+            .each_ref()
+            .map(|d| rows.map(|y| d.get(y).and_then(|r| r.get(..w)).unwrap_or(&[])));
+        let index = self.index;
+        let mut verify = |x: usize| {
+            let c = cube(&planes, x);
+            if !is_extremum(&c, thr) || !passes_edge_test(&c[1], edge_ratio) {
+                return;
             }
-            let mut c: Cube = [[[0; 3]; 3]; 3];
-            for (s, plane) in c.iter_mut().enumerate() {
-                for (row, &y) in plane.iter_mut().zip(&rows) {
-                    let d = &self.dog[s][y];
-                    *row = [d[x - 1], d[x], d[x + 1]];
-                }
-            }
-            if !is_extremum(&c, self.config.contrast_threshold)
-                || !passes_edge_test(&c[1], self.config.edge_ratio)
-            {
-                continue;
-            }
-            if let Some([dx, dy, ds]) = refine(&c, self.config.max_offset) {
+            if let Some([dx, dy, ds]) = refine(&c, max_offset) {
                 out.push_point(Extremum {
                     x: x as u16,
                     y: yc,
-                    octave: self.index,
+                    octave: index,
                     scale: 1,
                     dx,
                     dy,
@@ -296,6 +280,84 @@ impl<const W: usize> FastOctave<W> {
                     dog: c[1][1][1],
                 });
             }
+        };
+        // Blocks of centres are screened branch-free on necessary conditions, and only the
+        // survivors take the 26-neighbour test on their cube; the last centres, fewer than a
+        // block, take it one by one.
+        let mut x = 1;
+        while x + 1 < w {
+            if let Some(mut mask) = screen(&planes, x, thr) {
+                while mask != 0 {
+                    verify(x + mask.trailing_zeros() as usize);
+                    mask &= mask - 1;
+                }
+                x += SCREEN_BLOCK;
+            } else {
+                verify(x);
+                x += 1;
+            }
         }
     }
+}
+
+/// Centres screened at once by [`screen`]: 16 `i16` lanes, two SSE2 registers.
+const SCREEN_BLOCK: usize = 16;
+
+/// The `SCREEN_BLOCK` samples of `row` from column `x`, or `None` past its end.
+#[inline(always)]
+fn block(row: &[i16], x: usize) -> Option<&[i16; SCREEN_BLOCK]> {
+    row.get(x..x + SCREEN_BLOCK)?.try_into().ok()
+}
+
+/// For the centres `x .. x + SCREEN_BLOCK` (`x >= 1`) of the middle DoG `planes[1][1]`, bit
+/// `j` clear when centre `x + j` cannot be an extremum: its contrast is too low, or one of its
+/// six face neighbours (left, right, up, down, the DoGs below and above) is not strictly
+/// beyond it. `None` when the block's right neighbours run past the row.
+///
+/// Fixed-size arrays, `max`/`min` and no early exit, so it compiles to SSE2 `pmaxsw`/`pminsw`
+/// over eight lanes: on smooth images many centres pass the contrast test and the per-pixel
+/// branches of a scalar screen mispredict.
+#[inline(always)]
+fn screen(planes: &[[&[i16]; 3]; 3], x: usize, threshold: u16) -> Option<u32> {
+    let [below, mid, above] = planes;
+    let v = block(mid[1], x)?;
+    let faces = [
+        block(mid[1], x - 1)?,
+        block(mid[1], x + 1)?,
+        block(mid[0], x)?,
+        block(mid[2], x)?,
+        block(below[1], x)?,
+        block(above[1], x)?,
+    ];
+    // `v > threshold` and `v < -threshold` in i16: a threshold above i16::MAX admits no
+    // maximum, one below i16::MIN no minimum, so clamping both bounds keeps the verdicts.
+    let high = threshold.min(i16::MAX as u16) as i16;
+    let low = (-i32::from(threshold)).max(i32::from(i16::MIN)) as i16;
+    let mut mask = 0u32;
+    for j in 0..SCREEN_BLOCK {
+        let [a, b, c, d, e, f] = faces.map(|face| face[j]);
+        let (hi, lo) = (
+            a.max(b).max(c).max(d).max(e).max(f),
+            a.min(b).min(c).min(d).min(e).min(f),
+        );
+        let v = v[j];
+        let hit = (v > high && v > hi) || (v < low && v < lo);
+        mask |= u32::from(hit) << j;
+    }
+    Some(mask)
+}
+
+/// The 3x3x3 DoG cube around column `x` (`1 <= x`) of `planes[s][row]`; samples past a
+/// row's end (none for `x < w - 1`) read as 0.
+#[inline(always)]
+fn cube(planes: &[[&[i16]; 3]; 3], x: usize) -> Cube {
+    let mut c: Cube = [[[0; 3]; 3]; 3];
+    for (cs, plane) in c.iter_mut().zip(planes) {
+        for (cr, row) in cs.iter_mut().zip(plane) {
+            for (v, i) in cr.iter_mut().zip(x - 1..) {
+                *v = row.get(i).copied().unwrap_or(0);
+            }
+        }
+    }
+    c
 }
