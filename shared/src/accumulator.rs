@@ -2,10 +2,14 @@
 
 use heapless::Vec;
 
+use crate::cobs_in_place::first_zero;
 use crate::frame::{decode, DELIMITER};
 use crate::packet::header::Header;
 use crate::packet_repr::PacketRepr;
 use crate::Error;
+
+// `first_zero` finds frame ends because the delimiter is the byte COBS removes.
+const _: () = assert!(DELIMITER == 0);
 
 /// Collects the bytes of one COBS frame in a buffer of `N` bytes and decodes it when its
 /// `0x00` arrives.
@@ -80,11 +84,12 @@ impl<const N: usize> Accumulator<N> {
         }
         let mut input = input;
         loop {
-            let mut parts = input.splitn(2, |&byte| byte == DELIMITER);
-            let chunk = parts.next().unwrap_or_default();
-            let (delimited, rest) = match parts.next() {
-                Some(rest) => (true, rest),
-                None => (false, &[][..]),
+            // A word-at-a-time scan: a full-Sobel stream is megabytes per frame pair, and a
+            // byte-wise split was a visible part of the host's decoding.
+            let end = first_zero(input);
+            let (chunk, delimited, rest) = match (input.get(..end), input.get(end + 1..)) {
+                (Some(chunk), Some(rest)) => (chunk, true, rest),
+                _ => (input, false, &[][..]),
             };
             if self.discarding {
                 if !delimited {

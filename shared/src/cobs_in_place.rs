@@ -126,7 +126,7 @@ const HIGHS: usize = ONES << 7;
 /// A machine word at a time: `(w - 0x01..01) & !w & 0x80..80` flags the zero bytes of `w` (a
 /// borrow can flag a byte above a zero too, never one below the first, so the lowest flag is
 /// exact).
-fn first_zero(bytes: &[u8]) -> usize {
+pub(crate) fn first_zero(bytes: &[u8]) -> usize {
     let mut words = bytes.chunks_exact(WORD);
     let mut index = 0;
     for word in &mut words {

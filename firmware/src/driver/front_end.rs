@@ -79,12 +79,21 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         }
     }
 
+    // The driver pops one pixel at a time, as the soft-core reads the FIFO register: matched
+    // here rather than through `front_end()`, so each pop is a direct call the compiler can
+    // inline into the driver's loop instead of a virtual one.
     fn pop_point(&mut self) -> Option<Extremum> {
-        self.front_end().pop_point()
+        match self {
+            Self::Fast(fe) => fe.pop_point(),
+            Self::RegisterLevel(fe) => fe.pop_point(),
+        }
     }
 
     fn pop_sobel(&mut self) -> Option<SobelPixel> {
-        self.front_end().pop_sobel()
+        match self {
+            Self::Fast(fe) => fe.pop_sobel(),
+            Self::RegisterLevel(fe) => fe.pop_sobel(),
+        }
     }
 
     fn overflow(&self) -> Overflow {

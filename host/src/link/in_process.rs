@@ -22,9 +22,7 @@ use stereocal_firmware::driver::{
     PacketWriter,
 };
 use stereocal_hdl::RegisterBank;
-use stereocal_wire::{
-    decode, Accumulator, Camera, FeedResult, PacketRepr, DELIMITER, MAX_FRAME_LEN,
-};
+use stereocal_wire::{decode, Accumulator, Camera, FeedResult, PacketRepr, MAX_FRAME_LEN};
 
 use super::{Link, LinkError};
 
@@ -39,11 +37,16 @@ type FullChannel = Channel<RegisterBank, FabricModel, 1280>;
 struct Outbox {
     bytes: Vec<u8>,
     read: usize,
+    /// Where each write ended. A packet writer writes one frame per call, so for the right
+    /// camera's outbox these are its frames' ends: they are renumbered without a scan for
+    /// delimiters.
+    write_ends: Vec<usize>,
 }
 
 impl ByteSink for Outbox {
     fn write(&mut self, bytes: &[u8]) {
         self.bytes.extend_from_slice(bytes);
+        self.write_ends.push(self.bytes.len());
     }
 }
 
@@ -138,11 +141,15 @@ impl InProcessLink {
         self.writer.sink_mut().write(&left_out.into_sink().bytes);
         self.writer.set_next_seq(left_next);
         let left_summary = left_result.map_err(|e| channel_error(Camera::Left, &e))?;
-        let mut right_bytes = right_out.into_sink().bytes;
-        for frame in right_bytes.split_mut(|&b| b == DELIMITER) {
-            if frame.is_empty() {
-                continue;
-            }
+        let Outbox {
+            bytes: mut right_bytes,
+            write_ends,
+            ..
+        } = right_out.into_sink();
+        let mut start = 0;
+        for end in write_ends {
+            let frame = right_bytes.get_mut(start..end).unwrap_or_default();
+            start = end;
             let (_, packet) = decode(frame).map_err(|e| {
                 LinkError::Device(format!(
                     "right channel: its own packet does not decode: {e}"
@@ -237,6 +244,7 @@ impl Link for InProcessLink {
         if outbox.read == outbox.bytes.len() {
             // Everything read: reuse the allocation for the next frame.
             outbox.bytes.clear();
+            outbox.write_ends.clear();
             outbox.read = 0;
         }
         Ok(n)
