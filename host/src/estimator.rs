@@ -15,10 +15,10 @@ use crate::descriptor::{describe, DescriptorConfig};
 use crate::essential::constrained::{self, VergeAngles};
 use crate::essential::general::{self, RelativePose, YawPitchRoll};
 use crate::essential::{cauchy_cost, Correspondence, EssentialError, RefineConfig};
-use crate::frame::{FeatureFrame, SobelPlane};
+use crate::frame::{FeatureFrame, Keypoint, SobelPlane};
 use crate::matching::{match_descriptors, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
-use crate::subpixel::{guided_pair, refine_pair, SubpixelConfig};
+use crate::subpixel::{guided_pair, refine_pair, RefinedPair, SubpixelConfig};
 
 /// A matched point pair in full-resolution pixels: (left, right).
 pub type PixelPair = ([f64; 2], [f64; 2]);
@@ -367,53 +367,67 @@ fn guided_pairs(
         matched[m.left as usize] = true;
     }
     let max_d2 = g.max_neighbour_distance_px * g.max_neighbour_distance_px;
-    let mut near: Vec<(f32, usize)> = Vec::with_capacity(pairs.len());
-    let mut taken: Vec<[f32; 2]> = pairs
+    let described: Vec<[f32; 2]> = pairs
         .iter()
         .map(|((l, _), _)| [l[0] as f32, l[1] as f32])
         .collect();
-    let mut out = Vec::new();
-    for (k, kp) in left.keypoints().iter().enumerate() {
-        if matched[k] {
-            continue;
-        }
-        // Several keypoints (octaves) can sit on the same pixel: use each location once.
-        if taken
+    // Several keypoints (octaves) can sit on the same pixel: each location is used once.
+    let near_any = |taken: &[[f32; 2]], kp: &Keypoint| {
+        taken
             .iter()
             .any(|t| (t[0] - kp.x).abs() < 1.5 && (t[1] - kp.y).abs() < 1.5)
-        {
+    };
+    // The searches are independent: both cores run them. Which of them a location already
+    // taken by an earlier guided match rules out is settled afterwards, in keypoint order,
+    // which gives the matches a one-by-one loop would.
+    let found: Vec<(&Keypoint, RefinedPair)> = left
+        .keypoints()
+        .par_iter()
+        .enumerate()
+        .filter(|&(k, kp)| !matched[k] && !near_any(&described, kp))
+        .map_init(
+            || Vec::with_capacity(pairs.len()),
+            |near: &mut Vec<(f32, usize)>, (_, kp)| {
+                near.clear();
+                near.extend(pairs.iter().enumerate().filter_map(|(i, ((l, _), _))| {
+                    let d2 = (l[0] as f32 - kp.x).powi(2) + (l[1] as f32 - kp.y).powi(2);
+                    (d2 <= max_d2).then_some((d2, i))
+                }));
+                if near.len() < g.neighbours {
+                    return None;
+                }
+                near.select_nth_unstable_by(g.neighbours - 1, |a, b| a.0.total_cmp(&b.0));
+                let median = |d: fn(&PixelPair) -> f64| {
+                    let mut v: Vec<f32> = near[..g.neighbours]
+                        .iter()
+                        .map(|&(_, i)| d(&pairs[i].0) as f32)
+                        .collect();
+                    v.sort_by(f32::total_cmp);
+                    v[v.len() / 2]
+                };
+                let guess = [
+                    kp.x + median(|(l, r)| r[0] - l[0]),
+                    kp.y + median(|(l, r)| r[1] - l[1]),
+                ];
+                guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, sub).map(|r| (kp, r))
+            },
+        )
+        .flatten()
+        .collect();
+    let mut taken = Vec::new();
+    let mut out = Vec::new();
+    for (kp, r) in found {
+        if near_any(&taken, kp) {
             continue;
         }
-        near.clear();
-        near.extend(pairs.iter().enumerate().filter_map(|(i, ((l, _), _))| {
-            let d2 = (l[0] as f32 - kp.x).powi(2) + (l[1] as f32 - kp.y).powi(2);
-            (d2 <= max_d2).then_some((d2, i))
-        }));
-        if near.len() < g.neighbours {
-            continue;
-        }
-        near.select_nth_unstable_by(g.neighbours - 1, |a, b| a.0.total_cmp(&b.0));
-        let mut du: Vec<f32> = near[..g.neighbours]
-            .iter()
-            .map(|&(_, i)| (pairs[i].0 .1[0] - pairs[i].0 .0[0]) as f32)
-            .collect();
-        let mut dv: Vec<f32> = near[..g.neighbours]
-            .iter()
-            .map(|&(_, i)| (pairs[i].0 .1[1] - pairs[i].0 .0[1]) as f32)
-            .collect();
-        du.sort_by(f32::total_cmp);
-        dv.sort_by(f32::total_cmp);
-        let guess = [kp.x + du[du.len() / 2], kp.y + dv[dv.len() / 2]];
-        if let Some(r) = guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, sub) {
-            taken.push(r.left);
-            out.push((
-                (
-                    [r.left[0] as f64, r.left[1] as f64],
-                    [r.right[0] as f64, r.right[1] as f64],
-                ),
-                Some(r.sigma_v),
-            ));
-        }
+        taken.push(r.left);
+        out.push((
+            (
+                [r.left[0] as f64, r.left[1] as f64],
+                [r.right[0] as f64, r.right[1] as f64],
+            ),
+            Some(r.sigma_v),
+        ));
     }
     out
 }

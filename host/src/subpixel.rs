@@ -220,13 +220,20 @@ fn ncc_at(
     }
     let (wa, wb) = (a.width() as i32, b.width() as i32);
     let (ma, mb) = (a.magnitude(), b.magnitude());
-    let (mut sa, mut sb, mut saa, mut sbb, mut sab) = (0f32, 0f32, 0f32, 0f32, 0f32);
+    // Integer sums: exact, and loops over `u8` rows the compiler vectorises. Up to the default
+    // 15x15 window every sum stays below 2^24 (225 products of at most 255²), so they convert
+    // to `f32` exactly and the result equals a float accumulation's; u32 holds them up to
+    // windows of 257x257.
+    let (mut sa, mut sb, mut saa, mut sbb, mut sab) = (0u32, 0u32, 0u32, 0u32, 0u32);
+    let len = (2 * half + 1) as usize;
     for dy in -half..=half {
         let ra = ((ay + dy) * wa + ax - half) as usize;
         let rb = ((by + dy) * wb + bx - half) as usize;
-        let len = (2 * half + 1) as usize;
-        for (&x, &y) in ma[ra..ra + len].iter().zip(&mb[rb..rb + len]) {
-            let (x, y) = (x as f32, y as f32);
+        let (Some(row_a), Some(row_b)) = (ma.get(ra..ra + len), mb.get(rb..rb + len)) else {
+            return None;
+        };
+        for (&x, &y) in row_a.iter().zip(row_b) {
+            let (x, y) = (u32::from(x), u32::from(y));
             sa += x;
             sb += y;
             saa += x * x;
@@ -234,6 +241,7 @@ fn ncc_at(
             sab += x * y;
         }
     }
+    let (sa, sb, saa, sbb, sab) = (sa as f32, sb as f32, saa as f32, sbb as f32, sab as f32);
     let n = ((2 * half + 1) * (2 * half + 1)) as f32;
     let va = saa - sa * sa / n;
     let vb = sbb - sb * sb / n;
