@@ -3,7 +3,7 @@
 use heapless::Vec;
 
 use crate::cobs_in_place::first_zero;
-use crate::frame::{decode, DELIMITER};
+use crate::frame::{decode_zero_free, DELIMITER};
 use crate::packet::header::Header;
 use crate::packet_repr::PacketRepr;
 use crate::Error;
@@ -113,7 +113,8 @@ impl<const N: usize> Accumulator<N> {
                 continue;
             }
             self.delivered = true;
-            return match decode(&mut self.buf) {
+            // Every chunk was cut before a zero, so the frame holds none.
+            return match decode_zero_free(&mut self.buf) {
                 Ok((header, packet)) => FeedResult::Success {
                     header,
                     packet,
