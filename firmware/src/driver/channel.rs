@@ -71,9 +71,16 @@ pub fn fabric_config(registers: &FabricConfig) -> Config {
 pub struct Driver<B: RegisterBus, F: FrontEnd, const W0: usize = 1280> {
     bus: B,
     fabric: F,
-    camera: Camera,
     capabilities: Capabilities,
     next_frame_id: u32,
+    output: FrameOutput<W0>,
+}
+
+/// Everything of a channel but its bus and fabric: what turns the fabric's streams into
+/// packets. Kept apart from the fabric so the fabric can hand its Sobel FIFO over in bulk
+/// (`drain_sobel`) to a callback that borrows this part mutably.
+struct FrameOutput<const W0: usize> {
+    camera: Camera,
     frame: FrameState,
     ring: SobelRing<W0>,
     patches: PatchQueue,
@@ -88,21 +95,23 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         Self {
             bus,
             fabric,
-            camera,
             capabilities: CHANNEL_CAPABILITIES,
             next_frame_id: 0,
-            frame: FrameState {
-                id: 0,
-                mode: SobelOutput::Patches,
-                sobel_scale: 0,
-                points: 0,
-                sobel_packets: 0,
-                patches_dropped: 0,
+            output: FrameOutput {
+                camera,
+                frame: FrameState {
+                    id: 0,
+                    mode: SobelOutput::Patches,
+                    sobel_scale: 0,
+                    points: 0,
+                    sobel_packets: 0,
+                    patches_dropped: 0,
+                },
+                ring: SobelRing::new(),
+                patches: PatchQueue::new(),
+                batch: PointBatch::new(),
+                patch: [SobelPixel::default(); PATCH_PIXELS],
             },
-            ring: SobelRing::new(),
-            patches: PatchQueue::new(),
-            batch: PointBatch::new(),
-            patch: [SobelPixel::default(); PATCH_PIXELS],
         }
     }
 
@@ -114,7 +123,7 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
 
     /// The camera this channel serves.
     pub fn camera(&self) -> Camera {
-        self.camera
+        self.output.camera
     }
 
     /// The number the next frame will get.
@@ -222,11 +231,12 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         self.fabric
             .start_frame(&config)
             .map_err(DriverError::FabricConfig)?;
-        self.ring
+        self.output
+            .ring
             .start(registers.width, registers.height, registers.octaves);
-        self.patches.clear();
-        self.batch.clear();
-        self.frame = FrameState {
+        self.output.patches.clear();
+        self.output.batch.clear();
+        self.output.frame = FrameState {
             id: self.next_frame_id,
             mode: registers.sobel_output,
             sobel_scale: registers.sobel_scale,
@@ -239,8 +249,8 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         send(
             out,
             &PacketRepr::FrameStart(FrameStartRepr {
-                frame_id: self.frame.id,
-                camera: self.camera,
+                frame_id: self.output.frame.id,
+                camera: self.output.camera,
                 width: registers.width,
                 height: registers.height,
                 octaves: registers.octaves,
@@ -264,16 +274,18 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         if !flushed {
             return Err(DriverError::Frame(FrameError::FlushTimeout));
         }
-        for completed in self.ring.finish().into_iter().flatten() {
-            self.rows_completed(completed, out)?;
+        for completed in self.output.ring.finish().into_iter().flatten() {
+            self.output.rows_completed(completed, out)?;
         }
-        while let Some(patch) = self.patches.take_first(|_| true) {
-            self.send_patch(&patch, out)?;
+        while let Some(patch) = self.output.patches.take_first(|_| true) {
+            self.output.send_patch(&patch, out)?;
         }
-        self.send_points(out)?;
+        self.output.send_points(out)?;
 
         let overflow = self.fabric.overflow();
-        let dropped_sobel = overflow.sobel.saturating_add(self.frame.patches_dropped);
+        let dropped_sobel = overflow
+            .sobel
+            .saturating_add(self.output.frame.patches_dropped);
         let mut flags = FrameEndFlags(0);
         if overflow.points > 0 {
             flags = flags | FrameEndFlags::POINT_FIFO_OVERFLOW;
@@ -284,35 +296,44 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         send(
             out,
             &PacketRepr::FrameEnd(FrameEndRepr {
-                frame_id: self.frame.id,
-                camera: self.camera,
-                point_count: self.frame.points,
-                sobel_count: self.frame.sobel_packets,
+                frame_id: self.output.frame.id,
+                camera: self.output.camera,
+                point_count: self.output.frame.points,
+                sobel_count: self.output.frame.sobel_packets,
                 flags,
                 dropped_points: overflow.points,
                 dropped_sobel,
             }),
         )?;
         Ok(FrameSummary {
-            frame_id: self.frame.id,
-            points: self.frame.points,
-            sobel_packets: self.frame.sobel_packets,
+            frame_id: self.output.frame.id,
+            points: self.output.frame.points,
+            sobel_packets: self.output.frame.sobel_packets,
             overflow,
-            patches_dropped: self.frame.patches_dropped,
+            patches_dropped: self.output.frame.patches_dropped,
         })
     }
 
     /// Empties both FIFOs, points first.
     fn drain<S: ByteSink>(&mut self, out: &mut PacketWriter<S>) -> Result<(), DriverError> {
         while let Some(point) = self.fabric.pop_point() {
-            self.on_point(&point, out)?;
+            self.output.on_point(&point, out)?;
         }
-        while let Some(pixel) = self.fabric.pop_sobel() {
-            self.on_sobel(&pixel, out)?;
-        }
-        Ok(())
+        // In bulk, so the ring can take runs of a row at once. A slice handed over after an
+        // error is dropped unread: the frame is abandoned anyway, and the next one starts by
+        // clearing the FIFOs.
+        let mut result = Ok(());
+        let output = &mut self.output;
+        self.fabric.drain_sobel(&mut |pixels| {
+            if result.is_ok() {
+                result = output.on_sobel(pixels, out);
+            }
+        });
+        result
     }
+}
 
+impl<const W0: usize> FrameOutput<W0> {
     fn on_point<S: ByteSink>(
         &mut self,
         point: &Extremum,
@@ -360,16 +381,24 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         }
     }
 
+    /// Stores consecutive pixels of the Sobel stream, sending what each row they complete
+    /// makes ready before storing the pixels after it.
     fn on_sobel<S: ByteSink>(
         &mut self,
-        pixel: &FabricSobel,
+        mut pixels: &[FabricSobel],
         out: &mut PacketWriter<S>,
     ) -> Result<(), DriverError> {
-        match self.ring.push(pixel) {
-            Ok(Some(completed)) => self.rows_completed(completed, out),
-            Ok(None) => Ok(()),
-            Err(e) => Err(DriverError::SobelOutOfOrder(e)),
+        while !pixels.is_empty() {
+            let (taken, completed) = self
+                .ring
+                .push_run(pixels)
+                .map_err(DriverError::SobelOutOfOrder)?;
+            if let Some(completed) = completed {
+                self.rows_completed(completed, out)?;
+            }
+            pixels = pixels.get(taken..).unwrap_or_default();
         }
+        Ok(())
     }
 
     /// Sends completed rows (rows mode) or the patches they made ready (patch mode).

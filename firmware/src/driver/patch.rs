@@ -70,8 +70,17 @@ impl PatchQueue {
         mut ready: impl FnMut(&PendingPatch) -> bool,
     ) -> Option<PendingPatch> {
         let i = self.entries.iter().position(&mut ready)?;
-        // `i` came from `position`, so it is in bounds and `remove` cannot panic.
-        Some(self.entries.remove(i))
+        // As `Vec::remove(i)`, but without its bounds assertion, which only the optimiser can
+        // prove dead (and, depending on inlining, leaves a panic path in the firmware ELF): the
+        // entry is swapped along to the back, the others keeping their order, and popped.
+        let mut rest = self.entries.iter_mut().skip(i);
+        if let Some(mut taken) = rest.next() {
+            for next in rest {
+                core::mem::swap(taken, next);
+                taken = next;
+            }
+        }
+        self.entries.pop()
     }
 }
 

@@ -202,6 +202,78 @@ impl<const W0: usize> SobelRing<W0> {
         }))
     }
 
+    /// Stores the leading pixels of `pixels` (at least one, when it is not empty) and reports
+    /// how many it took and the rows they completed; exactly as [`Self::push`] on each of them,
+    /// one at a time, would.
+    ///
+    /// The first pixel goes through [`Self::push`]. If it completed no row, it opened (or
+    /// continued) its row, so the pixels after it that continue that row (same octave and row,
+    /// columns one apart, ending at the last column at most) cannot fail and can only complete
+    /// their row with its last column: that run is checked in one vectorisable pass and copied
+    /// as a block. Anything else (a row's first pixel, a gap left by a dropped pixel, another
+    /// octave) ends the run and goes through [`Self::push`] on the next call, so its errors
+    /// and completions are reported as they would be pixel by pixel, and in the same order.
+    pub fn push_run(
+        &mut self,
+        pixels: &[FabricSobel],
+    ) -> Result<(usize, Option<Completed>), OutOfOrder> {
+        let Some((first, rest)) = pixels.split_first() else {
+            return Ok((0, None));
+        };
+        if let Some(completed) = self.push(first)? {
+            return Ok((1, Some(completed)));
+        }
+        let Some(rows) = self.octaves.get_mut(usize::from(first.octave)) else {
+            return Ok((1, None));
+        };
+        // `push` accepted `first` without completing its row: `first.x + 1 < rows.width`.
+        let room = usize::from(rows.width.saturating_sub(first.x + 1));
+        let candidates = rest.get(..room.min(rest.len())).unwrap_or_default();
+        let continues = |(p, x): (&FabricSobel, u16)| {
+            (p.octave == first.octave) & (p.y == first.y) & (p.x == x)
+        };
+        // Whole candidate block first (no early exit, so it vectorises); the pixel-wise search
+        // only when the block breaks off.
+        let columns = first.x + 1..;
+        let run = if candidates.iter().zip(columns.clone()).all(continues) {
+            candidates
+        } else {
+            let n = candidates
+                .iter()
+                .zip(columns)
+                .position(|c| !continues(c))
+                .unwrap_or(candidates.len());
+            candidates.get(..n).unwrap_or_default()
+        };
+        let start = rows.slot(first.y).start + usize::from(first.x) + 1;
+        let Some(cells) = self
+            .store
+            .as_flattened_mut()
+            .get_mut(start..start + run.len())
+        else {
+            return Ok((1, None));
+        };
+        for (cell, p) in cells.iter_mut().zip(run) {
+            *cell = SobelPixel {
+                magnitude: p.magnitude,
+                orientation: p.orientation,
+            };
+        }
+        // `run.len() < rows.width`, a `u16`.
+        let n = run.len() as u16;
+        let filled = rows.filled(first.y);
+        *filled = filled.saturating_add(n);
+        let completed = (first.x + n + 1 == rows.width).then(|| {
+            rows.next_row = first.y + 1;
+            rows.open = false;
+            Completed {
+                octave: first.octave,
+                rows: first.y..first.y + 1,
+            }
+        });
+        Ok((1 + run.len(), completed))
+    }
+
     /// Completes each octave's open row at the end of a frame.
     pub fn finish(&mut self) -> [Option<Completed>; MAX_OCTAVES] {
         let mut done = [const { None }; MAX_OCTAVES];

@@ -1035,3 +1035,183 @@ fn register_level_model_sends_the_same_records_as_the_fast_path() {
     }
     assert_eq!(results[0], results[1]);
 }
+
+/// A front end that hands its Sobel FIFO over one pixel per slice: the driver then stores
+/// every pixel on its own, as the per-pixel path did before runs were copied as blocks.
+struct OnePixelAtATime<F>(F);
+
+impl<F: FrontEnd> FrontEnd for OnePixelAtATime<F> {
+    fn start_frame(&mut self, c: &Config) -> Result<(), ConfigError> {
+        self.0.start_frame(c)
+    }
+    fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError> {
+        self.0.push_row(row)
+    }
+    fn blank_row(&mut self) -> bool {
+        self.0.blank_row()
+    }
+    fn frame_done(&self) -> bool {
+        self.0.frame_done()
+    }
+    fn pop_point(&mut self) -> Option<Extremum> {
+        self.0.pop_point()
+    }
+    fn pop_sobel(&mut self) -> Option<FabricSobel> {
+        self.0.pop_sobel()
+    }
+    fn overflow(&self) -> Overflow {
+        self.0.overflow()
+    }
+    fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
+        self.0.drain_points(sink)
+    }
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[FabricSobel])) {
+        self.0
+            .drain_sobel(&mut |pixels| pixels.chunks(1).for_each(&mut *sink))
+    }
+}
+
+/// The bytes `fabric` makes a driver send for `image`.
+fn wire_bytes<F: FrontEnd, const W0: usize>(
+    fabric: F,
+    config: &FabricConfig,
+    image: &[u8],
+) -> Vec<u8> {
+    let mut driver: std::boxed::Box<Driver<RegisterBank, F, W0>> =
+        std::boxed::Box::new(Driver::new(RegisterBank::new(), fabric, Camera::Left));
+    driver.configure(config).unwrap();
+    let mut link = PacketWriter::new(Collect::default());
+    driver.process_frame(image, 0, &mut link).unwrap();
+    link.sink().0.clone()
+}
+
+#[test]
+fn sobel_runs_stored_as_blocks_send_the_same_bytes_as_pixel_by_pixel() {
+    let image = blob_image(160, 120, 5);
+    for mode in [SobelOutput::Rows, SobelOutput::Patches] {
+        let config = FabricConfig {
+            sobel_output: mode,
+            ..TEXTURED
+        };
+        let bulk = wire_bytes::<_, 160>(FabricModel::<160, 80, 40, 20>::fast(), &config, &image);
+        let single = wire_bytes::<_, 160>(
+            OnePixelAtATime(FabricModel::<160, 80, 40, 20>::fast()),
+            &config,
+            &image,
+        );
+        assert_eq!(bulk, single, "{mode:?}");
+
+        // Dropped pixels: at a row's start, inside it, at its end, and whole rows.
+        let config = FabricConfig {
+            sobel_output: mode,
+            ..SMALL
+        };
+        let mut drop = vec![(0, 47, 3), (0, 0, 12), (0, 1, 12), (1, 10, 2), (1, 23, 5)];
+        drop.extend((0..48).map(|x| (0, x, 7)));
+        drop.extend((0..24).map(|x| (1, x, 19)));
+        let script = || Scripted {
+            points: vec![(14, extremum(0, 2, 12)), (30, extremum(1, 9, 4))],
+            drop: drop.clone(),
+            ..Scripted::default()
+        };
+        let image = vec![0u8; 48 * 40];
+        let bulk = wire_bytes::<_, 64>(script(), &config, &image);
+        let single = wire_bytes::<_, 64>(OnePixelAtATime(script()), &config, &image);
+        assert_eq!(bulk, single, "{mode:?}, dropped pixels");
+    }
+}
+
+#[test]
+fn push_run_reports_what_pixel_by_pixel_pushes_report() {
+    let px = |octave: u8, x: u16, y: u16| FabricSobel {
+        octave,
+        orientation: (x % 64) as u8,
+        magnitude: (y % 251) as u8 + 1,
+        x,
+        y,
+    };
+    // Octave 0 is 20 wide, octave 1 is 10 wide: whole rows, rows with gaps, octaves
+    // interleaved mid-row, a skipped row, an octave the frame lacks, columns going back, a row
+    // gone by and a column past the edge.
+    let mut stream: Vec<FabricSobel> = (0..20).map(|x| px(0, x, 0)).collect();
+    stream.extend((0..6).map(|x| px(1, x, 0)));
+    stream.extend((0..20).filter(|&x| x != 9).map(|x| px(0, x, 1)));
+    stream.extend((6..10).map(|x| px(1, x, 0)));
+    stream.extend((3..19).map(|x| px(0, x, 2)));
+    stream.extend((0..20).map(|x| px(0, x, 4)));
+    stream.extend((5..8).map(|x| px(0, x, 5)));
+    stream.push(px(2, 0, 0));
+    stream.extend((8..12).map(|x| px(0, x, 5)));
+    stream.extend([px(0, 13, 5), px(0, 12, 5), px(0, 14, 5)]);
+    stream.extend([px(0, 3, 2), px(0, 20, 6), px(0, 15, 5), px(0, 16, 5)]);
+
+    // Per pixel: the pixel each completion or error came after.
+    let mut single = sobel_ring::SobelRing::<20>::new();
+    single.start(20, 12, 2);
+    let mut expected = Vec::new();
+    for (i, p) in stream.iter().enumerate() {
+        match single.push(p) {
+            Ok(Some(c)) => expected.push((i, Ok(c))),
+            Ok(None) => {}
+            Err(e) => expected.push((i, Err(e))),
+        }
+    }
+
+    // In runs, going on after an error as the per-pixel loop did.
+    let mut runs = sobel_ring::SobelRing::<20>::new();
+    runs.start(20, 12, 2);
+    let mut got = Vec::new();
+    let mut next = 0;
+    while next < stream.len() {
+        match runs.push_run(&stream[next..]) {
+            Ok((taken, completed)) => {
+                assert!(taken >= 1);
+                next += taken;
+                if let Some(c) = completed {
+                    got.push((next - 1, Ok(c)));
+                }
+            }
+            Err(e) => {
+                got.push((next, Err(e)));
+                next += 1;
+            }
+        }
+    }
+    assert_eq!(got, expected);
+    assert!(expected.iter().any(|(_, r)| r.is_err()));
+    for octave in 0..2 {
+        for row in 0..12 {
+            assert_eq!(
+                single.row(octave, row),
+                runs.row(octave, row),
+                "{octave} {row}"
+            );
+        }
+        let (a, b) = (single.rows(octave).unwrap(), runs.rows(octave).unwrap());
+        assert_eq!(
+            (a.next_row(), a.oldest_row()),
+            (b.next_row(), b.oldest_row())
+        );
+    }
+}
+
+#[test]
+fn patch_queue_takes_the_first_ready_entry_and_keeps_the_others_in_order() {
+    let entry = |index: u16| patch::PendingPatch {
+        index,
+        octave: (index % 2) as u8,
+        x: index,
+        y: index,
+    };
+    let mut queue = patch::PatchQueue::new();
+    for index in 0..6 {
+        queue.push(entry(index)).unwrap();
+    }
+    assert_eq!(queue.take_first(|p| p.octave == 1), Some(entry(1)));
+    assert_eq!(queue.take_first(|p| p.index == 5), Some(entry(5)));
+    assert_eq!(queue.take_first(|p| p.index == 9), None);
+    let rest: Vec<u16> = core::iter::from_fn(|| queue.take_first(|_| true))
+        .map(|p| p.index)
+        .collect();
+    assert_eq!(rest, [0, 2, 3, 4]);
+}
