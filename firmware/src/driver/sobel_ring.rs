@@ -209,10 +209,10 @@ impl<const W0: usize> SobelRing<W0> {
     /// The first pixel goes through [`Self::push`]. If it completed no row, it opened (or
     /// continued) its row, so the pixels after it that continue that row (same octave and row,
     /// columns one apart, ending at the last column at most) cannot fail and can only complete
-    /// their row with its last column: that run is checked in one vectorisable pass and copied
-    /// as a block. Anything else (a row's first pixel, a gap left by a dropped pixel, another
-    /// octave) ends the run and goes through [`Self::push`] on the next call, so its errors
-    /// and completions are reported as they would be pixel by pixel, and in the same order.
+    /// their row with its last column: that run is found in one pass and copied as a block.
+    /// Anything else (a row's first pixel, a gap left by a dropped pixel, another octave) ends
+    /// the run and goes through [`Self::push`] on the next call, so its errors and completions
+    /// are reported as they would be pixel by pixel, and in the same order.
     pub fn push_run(
         &mut self,
         pixels: &[FabricSobel],
@@ -229,22 +229,14 @@ impl<const W0: usize> SobelRing<W0> {
         // `push` accepted `first` without completing its row: `first.x + 1 < rows.width`.
         let room = usize::from(rows.width.saturating_sub(first.x + 1));
         let candidates = rest.get(..room.min(rest.len())).unwrap_or_default();
-        let continues = |(p, x): (&FabricSobel, u16)| {
-            (p.octave == first.octave) & (p.y == first.y) & (p.x == x)
-        };
-        // Whole candidate block first (no early exit, so it vectorises); the pixel-wise search
-        // only when the block breaks off.
-        let columns = first.x + 1..;
-        let run = if candidates.iter().zip(columns.clone()).all(continues) {
-            candidates
-        } else {
-            let n = candidates
-                .iter()
-                .zip(columns)
-                .position(|c| !continues(c))
-                .unwrap_or(candidates.len());
-            candidates.get(..n).unwrap_or_default()
-        };
+        let continues =
+            |(p, x): (&FabricSobel, u16)| p.octave == first.octave && p.y == first.y && p.x == x;
+        let n = candidates
+            .iter()
+            .zip(first.x + 1..)
+            .position(|c| !continues(c))
+            .unwrap_or(candidates.len());
+        let run = candidates.get(..n).unwrap_or_default();
         let start = rows.slot(first.y).start + usize::from(first.x) + 1;
         let Some(cells) = self
             .store
@@ -259,11 +251,11 @@ impl<const W0: usize> SobelRing<W0> {
                 orientation: p.orientation,
             };
         }
-        // `run.len() < rows.width`, a `u16`.
-        let n = run.len() as u16;
+        // `n < rows.width`, a `u16`.
+        let added = n as u16;
         let filled = rows.filled(first.y);
-        *filled = filled.saturating_add(n);
-        let completed = (first.x + n + 1 == rows.width).then(|| {
+        *filled = filled.saturating_add(added);
+        let completed = (first.x + added + 1 == rows.width).then(|| {
             rows.next_row = first.y + 1;
             rows.open = false;
             Completed {
