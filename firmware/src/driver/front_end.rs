@@ -91,10 +91,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
     }
 
     fn pop_sobel(&mut self) -> Option<SobelPixel> {
-        match self {
-            Self::Fast(fe) => fe.pop_sobel(),
-            Self::RegisterLevel(fe) => fe.pop_sobel(),
-        }
+        self.front_end().pop_sobel()
     }
 
     fn overflow(&self) -> Overflow {
