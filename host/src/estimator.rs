@@ -182,14 +182,7 @@ impl VergeEstimator {
                 let kr = right.keypoints()[m.right as usize];
                 match (self.config.subpixel, planes) {
                     (Some(cfg), Some((pl, pr))) => {
-                        let r = refine_pair(pl, pr, [kl.x, kl.y], [kr.x, kr.y], &cfg)?;
-                        Some((
-                            (
-                                [r.left[0] as f64, r.left[1] as f64],
-                                [r.right[0] as f64, r.right[1] as f64],
-                            ),
-                            Some(r.sigma_v),
-                        ))
+                        refine_pair(pl, pr, [kl.x, kl.y], [kr.x, kr.y], &cfg).map(refined)
                     }
                     _ => Some((
                         ([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64]),
@@ -319,6 +312,17 @@ impl VergeEstimator {
     }
 }
 
+/// A refined match as the estimator takes it: the pixel pair and its vertical 1-σ.
+fn refined(r: RefinedPair) -> (PixelPair, Option<f32>) {
+    (
+        (
+            [f64::from(r.left[0]), f64::from(r.left[1])],
+            [f64::from(r.right[0]), f64::from(r.right[1])],
+        ),
+        Some(r.sigma_v),
+    )
+}
+
 /// The refinement weight of each pair (see [`EstimatorConfig::weight_floor_px`]), scaled so
 /// that the median weight is 1: the robust scale of the residuals, and with it the refinement's
 /// residual floor and inlier limit, keep their meaning in pixels of a typical match.
@@ -421,13 +425,7 @@ fn guided_pairs(
             continue;
         }
         taken.push(r.left);
-        out.push((
-            (
-                [r.left[0] as f64, r.left[1] as f64],
-                [r.right[0] as f64, r.right[1] as f64],
-            ),
-            Some(r.sigma_v),
-        ));
+        out.push(refined(r));
     }
     out
 }
