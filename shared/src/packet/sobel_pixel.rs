@@ -63,6 +63,12 @@ pub(crate) fn all_valid(pixels: &[u8]) -> bool {
         .fold(0u16, |ored, pixel| {
             ored | u16::from_le_bytes(pixel.try_into().unwrap_or_default())
         });
+    orientations_fit(ored)
+}
+
+/// Whether pixels ORed together as little-endian `u16`s (orientation in the high byte) have
+/// no orientation bit above [`ORIENTATION_BITS`], i.e. every one of them is valid.
+fn orientations_fit(ored: u16) -> bool {
     let [_, orientations] = ored.to_le_bytes();
     orientations & !ORIENTATION_MASK == 0
 }
@@ -75,11 +81,9 @@ pub(crate) fn all_records_valid(pixels: &Records<'_, SobelPixel>) -> bool {
         Records::Values(values) => {
             // Both fields, as the wire has them: one 16-bit load per pixel, which vectorises
             // where ORing the orientations alone took strided byte loads.
-            let ored = values.iter().fold(0u16, |ored, pixel| {
+            orientations_fit(values.iter().fold(0u16, |ored, pixel| {
                 ored | u16::from_le_bytes([pixel.magnitude, pixel.orientation])
-            });
-            let [_, orientations] = ored.to_le_bytes();
-            orientations & !ORIENTATION_MASK == 0
+            }))
         }
     }
 }
