@@ -112,6 +112,7 @@ impl Threaded {
 
 /// The worker: runs each job, then collects what the device sent.
 fn serve<D: Device>(mut device: D, inbox: mpsc::Receiver<Job>, shared: &Shared) {
+    let mut buf = vec![0; CHUNK];
     for job in inbox {
         let result = match job {
             Job::Send(bytes) => device.send(&bytes),
@@ -124,7 +125,6 @@ fn serve<D: Device>(mut device: D, inbox: mpsc::Receiver<Job>, shared: &Shared) 
         let mut bytes = Vec::new();
         let mut error = result.err();
         if error.is_none() {
-            let mut buf = vec![0; CHUNK];
             loop {
                 match device.recv(&mut buf, Instant::now()) {
                     Ok(n) => bytes.extend_from_slice(buf.get(..n).unwrap_or_default()),
