@@ -24,6 +24,7 @@ use stereocal_firmware::driver::{
 use stereocal_hdl::RegisterBank;
 use stereocal_wire::{decode, Accumulator, Camera, FeedResult, PacketRepr, MAX_FRAME_LEN};
 
+use super::renumber::renumber_in_place;
 use super::{Link, LinkError};
 
 /// Name in errors.
@@ -103,8 +104,9 @@ impl InProcessLink {
     ///
     /// The channels run concurrently. The left one numbers its packets from the link's next
     /// sequence number; the right one's are numbered from 0 and, once the left has finished,
-    /// decoded and sent again through the link's writer, which gives them the numbers that
-    /// follow the left camera's: the bytes are those of running the two one after the other.
+    /// given the numbers that follow the left camera's (in place where the frame allows,
+    /// [`renumber_in_place`], else decoded and sent again through the link's writer): the
+    /// bytes are those of running the two one after the other.
     /// Run one after the other, a left frame refused before its `FrameStart` (a wrong image
     /// size; register errors refuse both alike) would leave the right camera unrun and both
     /// frame numbers unused: images of different sizes therefore run one after the other, and
@@ -150,6 +152,12 @@ impl InProcessLink {
         for end in write_ends {
             let frame = right_bytes.get_mut(start..end).unwrap_or_default();
             start = end;
+            let seq = self.writer.next_seq();
+            if renumber_in_place(frame, seq) {
+                self.writer.sink_mut().write(frame);
+                self.writer.set_next_seq(seq.wrapping_add(1));
+                continue;
+            }
             let (_, packet) = decode(frame).map_err(|e| {
                 LinkError::Device(format!(
                     "right channel: its own packet does not decode: {e}"

@@ -24,6 +24,7 @@ mod error;
 mod fault;
 mod in_process;
 mod recording;
+mod renumber;
 mod replay;
 mod serial;
 mod stream;
