@@ -86,6 +86,25 @@ impl SobelPlane {
         magnitude: Vec<u8>,
         orientation: Vec<u8>,
     ) -> Result<Self, FrameError> {
+        // One branch-free OR over the plane (it vectorises), where searching for the first
+        // bad code took a compare and branch per pixel; the search only runs on a bad plane.
+        let codes = orientation.iter().fold(0, |ored, &code| ored | code);
+        Self::with_codes(octave, width, height, magnitude, orientation, codes)
+    }
+
+    /// [`Self::new`] for a caller that ORed every orientation code together (`codes`) while
+    /// writing the plane: the driver does so in the pass that splits the received pixels, so
+    /// a valid plane is not read a second time. A code of 64 or more sets a bit of `codes`
+    /// at or above [`ORIENTATION_STEPS`]; then the plane is searched for the first one, and
+    /// the error is the one [`Self::new`] gives.
+    pub(crate) fn with_codes(
+        octave: u8,
+        width: u32,
+        height: u32,
+        magnitude: Vec<u8>,
+        orientation: Vec<u8>,
+        codes: u8,
+    ) -> Result<Self, FrameError> {
         let n = width as usize * height as usize;
         if magnitude.len() != n || orientation.len() != n {
             return Err(FrameError::PlaneSize {
@@ -95,16 +114,18 @@ impl SobelPlane {
                 len: magnitude.len().min(orientation.len()),
             });
         }
-        if let Some((index, &code)) = orientation
-            .iter()
-            .enumerate()
-            .find(|(_, &c)| c >= ORIENTATION_STEPS)
-        {
-            return Err(FrameError::OrientationRange {
-                octave,
-                index,
-                code,
-            });
+        if codes >= ORIENTATION_STEPS {
+            if let Some((index, &code)) = orientation
+                .iter()
+                .enumerate()
+                .find(|(_, &c)| c >= ORIENTATION_STEPS)
+            {
+                return Err(FrameError::OrientationRange {
+                    octave,
+                    index,
+                    code,
+                });
+            }
         }
         Ok(Self {
             octave,

@@ -13,6 +13,10 @@ use stereocal_wire::{
 use super::damage::ContentError;
 use crate::frame::{FrameError, Gradients, Keypoint, SobelPatch, SobelPlane};
 
+/// Pixels [`split_pixels`] handles per step: a multiple of the SIMD width, and long enough
+/// that the per-step slicing is small next to the copying.
+const SPLIT_LANES: usize = 32;
+
 /// One octave's plane being filled row by row.
 #[derive(Debug)]
 pub(crate) struct PlaneBuilder {
@@ -20,10 +24,53 @@ pub(crate) struct PlaneBuilder {
     scale: u8,
     width: u16,
     height: u16,
+    /// The rows up to the furthest one received; grown a row at a time rather than
+    /// zero-filled whole up front, since rows come in order and every byte is written anyway.
     magnitude: Vec<u8>,
+    /// Same length as `magnitude`.
     orientation: Vec<u8>,
+    /// Every orientation code received, ORed together (for [`SobelPlane::with_codes`]).
+    codes: u8,
     have_row: Vec<bool>,
     rows: u32,
+}
+
+/// Splits wire-format Sobel pixels (magnitude, orientation byte pairs) into `magnitude` and
+/// `orientation` and returns their orientation codes ORed together.
+///
+/// Most of what a host receives is Sobel rows. Reading each pair as a little-endian `u16`
+/// into a fixed-size block and splitting that with shifts, with one OR accumulator per lane,
+/// compiles to packed loads, shifts and packs; the pair-by-pair loop it replaces (and one
+/// with a single scalar OR) did not vectorise.
+fn split_pixels(bytes: &[u8], magnitude: &mut [u8], orientation: &mut [u8]) -> u8 {
+    let mut lanes = [0u8; SPLIT_LANES];
+    let mut mags = magnitude.chunks_exact_mut(SPLIT_LANES);
+    let mut oris = orientation.chunks_exact_mut(SPLIT_LANES);
+    let mut pairs = bytes.chunks_exact(SPLIT_LANES * SobelPixel::LEN);
+    for ((m, o), px) in (&mut mags).zip(&mut oris).zip(&mut pairs) {
+        let mut words = [0u16; SPLIT_LANES];
+        for (w, pair) in words.iter_mut().zip(px.chunks_exact(SobelPixel::LEN)) {
+            if let [magnitude, orientation] = *pair {
+                *w = u16::from_le_bytes([magnitude, orientation]);
+            }
+        }
+        for (((m, o), lane), w) in m.iter_mut().zip(o).zip(&mut lanes).zip(words) {
+            let [magnitude, orientation] = w.to_le_bytes();
+            *m = magnitude;
+            *o = orientation;
+            *lane |= orientation;
+        }
+    }
+    let mut codes = lanes.iter().fold(0, |ored, &lane| ored | lane);
+    let rest = mags.into_remainder().iter_mut().zip(oris.into_remainder());
+    for ((m, o), pair) in rest.zip(pairs.remainder().chunks_exact(SobelPixel::LEN)) {
+        if let [magnitude, orientation] = *pair {
+            *m = magnitude;
+            *o = orientation;
+            codes |= orientation;
+        }
+    }
+    codes
 }
 
 /// A received patch, with where the device says it sits.
@@ -85,8 +132,9 @@ impl GradientBuilder {
                     scale: row.scale,
                     width: w,
                     height: h,
-                    magnitude: vec![0; n],
-                    orientation: vec![0; n],
+                    magnitude: Vec::with_capacity(n),
+                    orientation: Vec::with_capacity(n),
+                    codes: 0,
                     have_row: vec![false; usize::from(h)],
                     rows: 0,
                 });
@@ -127,30 +175,26 @@ impl GradientBuilder {
         plane.rows += 1;
         let start = r * usize::from(plane.width);
         let end = start + usize::from(plane.width);
+        if plane.magnitude.len() < end {
+            // The next row (or one past a gap, which a later row fills): zeroing only what
+            // the row is about to overwrite is cheap while it is in cache.
+            plane.magnitude.resize(end, 0);
+            plane.orientation.resize(end, 0);
+        }
         let mag = &mut plane.magnitude[start..end];
         let ori = &mut plane.orientation[start..end];
-        match row.pixels {
-            // As decoded from the wire: split the interleaved bytes in one pass the compiler
-            // can vectorise (the full-Sobel stream is most of what a host decodes).
-            Records::Wire(bytes) => {
-                for ((m, o), px) in mag
-                    .iter_mut()
-                    .zip(ori.iter_mut())
-                    .zip(bytes.chunks_exact(SobelPixel::LEN))
-                {
-                    if let [magnitude, orientation] = *px {
-                        *m = magnitude;
-                        *o = orientation;
-                    }
-                }
-            }
+        plane.codes |= match row.pixels {
+            Records::Wire(bytes) => split_pixels(bytes, mag, ori),
             Records::Values(pixels) => {
+                let mut codes = 0;
                 for ((m, o), px) in mag.iter_mut().zip(ori.iter_mut()).zip(pixels) {
                     *m = px.magnitude;
                     *o = px.orientation;
+                    codes |= px.orientation;
                 }
+                codes
             }
-        }
+        };
         Ok(())
     }
 
@@ -220,12 +264,13 @@ impl GradientBuilder {
                             rows: p.height,
                         }));
                     }
-                    let plane = SobelPlane::new(
+                    let plane = SobelPlane::with_codes(
                         p.octave,
                         p.width.into(),
                         p.height.into(),
                         p.magnitude,
                         p.orientation,
+                        p.codes,
                     )
                     .map_err(FinishError::Frame)?;
                     out.push(plane);
@@ -277,4 +322,75 @@ impl GradientBuilder {
 pub(crate) enum FinishError {
     Content(ContentError),
     Frame(FrameError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stereocal_wire::Camera;
+
+    /// Wire bytes of a `width`-pixel row whose pixel `i` is `(row·7 + i, (row + i) % 64)`.
+    fn wire_row(row: u16, width: u16) -> Vec<u8> {
+        (0..width)
+            .flat_map(|i| [(row * 7 + i) as u8, ((row + i) % 64) as u8])
+            .collect()
+    }
+
+    fn rows_packet(row: u16, pixels: Records<'_, SobelPixel>) -> SobelRowsRepr<'_> {
+        SobelRowsRepr {
+            frame_id: 1,
+            camera: Camera::Left,
+            octave: 0,
+            scale: 1,
+            row,
+            pixels,
+        }
+    }
+
+    #[test]
+    fn rows_in_any_order_split_into_planes() {
+        // 37 pixels: one whole block of the split and a tail.
+        let (width, height) = (37u16, 4u16);
+        let mut builder = GradientBuilder::Empty;
+        for row in [2, 0, 3, 1] {
+            let bytes = wire_row(row, width);
+            let packet = rows_packet(row, Records::Wire(&bytes));
+            assert!(builder.add_row(&packet, width, height, 1).is_ok());
+        }
+        let Ok(finished) = builder.finish(&[], Vec::new()) else {
+            panic!("complete plane refused");
+        };
+        let Gradients::Planes(planes) = finished.gradients else {
+            panic!("rows gave patches");
+        };
+        let bytes: Vec<u8> = (0..height).flat_map(|r| wire_row(r, width)).collect();
+        let magnitude: Vec<u8> = bytes.iter().step_by(2).copied().collect();
+        let orientation: Vec<u8> = bytes.iter().skip(1).step_by(2).copied().collect();
+        assert_eq!(planes[0].magnitude(), magnitude.as_slice());
+        assert_eq!(planes[0].orientation(), orientation.as_slice());
+    }
+
+    #[test]
+    fn wide_orientation_gives_the_planes_error() {
+        let (width, height) = (40u16, 2u16);
+        let mut builder = GradientBuilder::Empty;
+        let good = vec![SobelPixel::default(); usize::from(width)];
+        let mut bad = good.clone();
+        bad[35].orientation = 64;
+        let packets = [
+            rows_packet(0, Records::Values(&good)),
+            rows_packet(1, Records::Values(&bad)),
+        ];
+        for packet in &packets {
+            assert!(builder.add_row(packet, width, height, 1).is_ok());
+        }
+        assert!(matches!(
+            builder.finish(&[], Vec::new()),
+            Err(FinishError::Frame(FrameError::OrientationRange {
+                octave: 0,
+                index: 75,
+                code: 64
+            }))
+        ));
+    }
 }
