@@ -5,7 +5,7 @@
 //! in its frame-grabber region before it booted. A session does not care which: it hands
 //! every pair to [`Device::submit_pair`] and reads the packets back over the link.
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use super::{InProcessLink, Link, LinkError};
 
@@ -33,6 +33,21 @@ pub trait Device: Link {
     fn lookahead(&self) -> usize {
         0
     }
+
+    /// Appends to `out` every byte the device has sent so far and the host has not read.
+    /// The default reads them through [`Link::recv`] without waiting, so a wrapper that
+    /// records or damages what `recv` returns sees them; a device that holds its output in
+    /// memory hands it over whole.
+    fn take_sent(&mut self, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        let mut chunk = [0u8; 4096];
+        loop {
+            match self.recv(&mut chunk, Instant::now()) {
+                Ok(n) => out.extend_from_slice(chunk.get(..n).unwrap_or_default()),
+                Err(LinkError::Timeout { .. }) => return Ok(()),
+                Err(e) => return Err(e),
+            }
+        }
+    }
 }
 
 /// A borrowed device is a device: the caller keeps it, e.g. to stop an emulator and read its
@@ -54,6 +69,10 @@ impl<D: Device + ?Sized> Device for &mut D {
     fn lookahead(&self) -> usize {
         (**self).lookahead()
     }
+
+    fn take_sent(&mut self, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        (**self).take_sent(out)
+    }
 }
 
 impl Device for InProcessLink {
@@ -68,5 +87,10 @@ impl Device for InProcessLink {
 
     fn answer_timeout(&self) -> Duration {
         IN_PROCESS_TIMEOUT
+    }
+
+    fn take_sent(&mut self, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        InProcessLink::take_sent(self, out);
+        Ok(())
     }
 }

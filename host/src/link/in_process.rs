@@ -51,11 +51,46 @@ impl ByteSink for Outbox {
     }
 }
 
+impl Outbox {
+    /// Empties the outbox and keeps its allocations.
+    fn clear(&mut self) {
+        self.bytes.clear();
+        self.write_ends.clear();
+        self.read = 0;
+    }
+
+    /// Moves `bytes` to the end of the outbox, leaving `bytes` empty. An outbox the host has
+    /// read to the end trades buffers instead (see [`Self::take_into`]).
+    fn append(&mut self, bytes: &mut Vec<u8>) {
+        if self.read == self.bytes.len() {
+            self.clear();
+            std::mem::swap(&mut self.bytes, bytes);
+        } else {
+            self.bytes.append(bytes);
+        }
+        self.write_ends.push(self.bytes.len());
+    }
+
+    /// Moves the unread bytes into `out`. An empty `out` trades buffers with the outbox
+    /// instead: a pair is megabytes, and the buffers keep their sizes as they go round.
+    fn take_into(&mut self, out: &mut Vec<u8>) {
+        if out.is_empty() && self.read == 0 {
+            std::mem::swap(out, &mut self.bytes);
+        } else {
+            out.extend_from_slice(self.bytes.get(self.read..).unwrap_or_default());
+        }
+        self.clear();
+    }
+}
+
 /// The fabric model and the soft-core driver of both cameras, in this process.
 pub struct InProcessLink {
     left: Box<FullChannel>,
     right: Box<FullChannel>,
     writer: PacketWriter<Outbox>,
+    /// Each camera's packets of the pair being run, before they join `writer`'s outbox; kept
+    /// from pair to pair for their allocations.
+    pair_out: [PacketWriter<Outbox>; 2],
     inbox: Box<Accumulator<{ MAX_FRAME_LEN - 1 }>>,
 }
 
@@ -75,6 +110,10 @@ impl InProcessLink {
             left: boxed_channel(Camera::Left, model)?,
             right: boxed_channel(Camera::Right, model)?,
             writer: PacketWriter::new(Outbox::default()),
+            pair_out: [
+                PacketWriter::new(Outbox::default()),
+                PacketWriter::new(Outbox::default()),
+            ],
             inbox: Box::new(Accumulator::new()),
         })
     }
@@ -124,38 +163,37 @@ impl InProcessLink {
                 self.submit(Camera::Right, right, timestamp_us)?,
             ]);
         }
-        let start = self.writer.next_seq();
-        let (left_channel, right_channel) = (&mut self.left, &mut self.right);
-        let ((left_result, left_out), (right_result, right_out)) = rayon::join(
-            || {
-                let mut out = PacketWriter::new(Outbox::default());
-                out.set_next_seq(start);
-                let result = left_channel.process_frame(left, timestamp_us, &mut out);
-                (result, out)
-            },
-            || {
-                let mut out = PacketWriter::new(Outbox::default());
-                let result = right_channel.process_frame(right, timestamp_us, &mut out);
-                (result, out)
-            },
+        let Self {
+            left: left_channel,
+            right: right_channel,
+            writer,
+            pair_out: [left_out, right_out],
+            ..
+        } = self;
+        left_out.sink_mut().clear();
+        right_out.sink_mut().clear();
+        left_out.set_next_seq(writer.next_seq());
+        right_out.set_next_seq(0);
+        let (left_result, right_result) = rayon::join(
+            || left_channel.process_frame(left, timestamp_us, left_out),
+            || right_channel.process_frame(right, timestamp_us, right_out),
         );
-        let left_next = left_out.next_seq();
-        self.writer.sink_mut().write(&left_out.into_sink().bytes);
-        self.writer.set_next_seq(left_next);
+        writer.sink_mut().append(&mut left_out.sink_mut().bytes);
+        writer.set_next_seq(left_out.next_seq());
         let left_summary = left_result.map_err(|e| channel_error(Camera::Left, &e))?;
         let Outbox {
-            bytes: mut right_bytes,
+            bytes: right_bytes,
             write_ends,
             ..
-        } = right_out.into_sink();
+        } = right_out.sink_mut();
         let mut start = 0;
-        for end in write_ends {
+        for &end in write_ends.iter() {
             let frame = right_bytes.get_mut(start..end).unwrap_or_default();
             start = end;
-            let seq = self.writer.next_seq();
+            let seq = writer.next_seq();
             if renumber_in_place(frame, seq) {
-                self.writer.sink_mut().write(frame);
-                self.writer.set_next_seq(seq.wrapping_add(1));
+                writer.sink_mut().write(frame);
+                writer.set_next_seq(seq.wrapping_add(1));
                 continue;
             }
             let (_, packet) = decode(frame).map_err(|e| {
@@ -163,12 +201,18 @@ impl InProcessLink {
                     "right channel: its own packet does not decode: {e}"
                 ))
             })?;
-            self.writer
+            writer
                 .send(&packet)
                 .map_err(|e| LinkError::Device(format!("right channel: re-encoding: {e}")))?;
         }
         let right_summary = right_result.map_err(|e| channel_error(Camera::Right, &e))?;
         Ok([left_summary, right_summary])
+    }
+
+    /// Moves every byte the device sent and the host has not read into `out` (see
+    /// [`Device::take_sent`](super::Device::take_sent)).
+    pub fn take_sent(&mut self, out: &mut Vec<u8>) {
+        self.writer.sink_mut().take_into(out);
     }
 
     /// Bytes the device sent that the host has not read yet.
@@ -251,9 +295,7 @@ impl Link for InProcessLink {
         outbox.read += n;
         if outbox.read == outbox.bytes.len() {
             // Everything read: reuse the allocation for the next frame.
-            outbox.bytes.clear();
-            outbox.write_ends.clear();
-            outbox.read = 0;
+            outbox.clear();
         }
         Ok(n)
     }

@@ -23,9 +23,6 @@ use super::{Device, Link, LinkError};
 /// Pairs a session may have in the worker beyond the one it is reading.
 const LOOKAHEAD: usize = 1;
 
-/// Bytes collected from the device per `recv` call of the worker.
-const CHUNK: usize = 1 << 16;
-
 /// What the worker is asked to do, in order.
 enum Job {
     Send(Vec<u8>),
@@ -48,6 +45,8 @@ struct Output {
     error: Option<LinkError>,
     /// The worker has stopped (its thread ended or panicked).
     stopped: bool,
+    /// The last chunk read, for the worker to fill again.
+    spare: Option<Vec<u8>>,
 }
 
 #[derive(Default)]
@@ -112,7 +111,6 @@ impl Threaded {
 
 /// The worker: runs each job, then collects what the device sent.
 fn serve<D: Device>(mut device: D, inbox: mpsc::Receiver<Job>, shared: &Shared) {
-    let mut buf = vec![0; CHUNK];
     for job in inbox {
         let result = match job {
             Job::Send(bytes) => device.send(&bytes),
@@ -122,20 +120,10 @@ fn serve<D: Device>(mut device: D, inbox: mpsc::Receiver<Job>, shared: &Shared) 
                 timestamp_us,
             } => device.submit_pair(&left, &right, timestamp_us),
         };
-        let mut bytes = Vec::new();
-        let mut error = result.err();
-        if error.is_none() {
-            loop {
-                match device.recv(&mut buf, Instant::now()) {
-                    Ok(n) => bytes.extend_from_slice(buf.get(..n).unwrap_or_default()),
-                    Err(LinkError::Timeout { .. }) => break,
-                    Err(e) => {
-                        error = Some(e);
-                        break;
-                    }
-                }
-            }
-        }
+        // A buffer the host has read, so its allocation serves again.
+        let mut bytes = shared.lock().spare.take().unwrap_or_default();
+        bytes.clear();
+        let error = result.and_then(|()| device.take_sent(&mut bytes)).err();
         let mut out = shared.lock();
         if !bytes.is_empty() {
             out.chunks.push_back(bytes);
@@ -167,8 +155,8 @@ impl Link for Threaded {
                 buf[..n].copy_from_slice(&pending[..n]);
                 *read += n;
                 if *read >= front.len() {
-                    chunks.pop_front();
-                    *read = 0;
+                    out.spare = chunks.pop_front();
+                    out.read = 0;
                 }
                 return Ok(n);
             }
