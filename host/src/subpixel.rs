@@ -13,6 +13,8 @@
 //! uncertain), that do not converge, that move too far or whose windows do not agree after
 //! alignment are rejected.
 
+use std::cell::Cell;
+
 use crate::frame::SobelPlane;
 
 /// Settings of the refinement.
@@ -53,7 +55,8 @@ pub struct RefinedPair {
 
 /// Samples the `side` x `side` window of `p`'s magnitude centred on (`x`, `y`) into `out`,
 /// bilinearly. The window is a pure translation, so every sample shares one pair of
-/// fractional weights: the bounds are checked once and the loop is four loads and a blend.
+/// fractional weights: the bounds are checked once and the loop is four loads and a blend,
+/// over four equal-length row slices so that it compiles to vector code without bounds checks.
 /// `None` when the window (plus its interpolation neighbours) leaves the plane.
 fn sample_window(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> Option<()> {
     let (w, h) = (p.width() as i32, p.height() as i32);
@@ -70,14 +73,24 @@ fn sample_window(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> 
     for (r, row_out) in out.chunks_exact_mut(side).enumerate() {
         let top = &m[(iy as usize + r) * stride + ix as usize..][..side + 1];
         let bottom = &m[(iy as usize + r + 1) * stride + ix as usize..][..side + 1];
-        for (c, o) in row_out.iter_mut().enumerate() {
-            *o = w00 * f32::from(top[c])
-                + w01 * f32::from(top[c + 1])
-                + w10 * f32::from(bottom[c])
-                + w11 * f32::from(bottom[c + 1]);
+        let corners = top[..side]
+            .iter()
+            .zip(&top[1..])
+            .zip(&bottom[..side])
+            .zip(&bottom[1..]);
+        for (o, (((&a, &b), &c), &d)) in row_out.iter_mut().zip(corners) {
+            *o = w00 * f32::from(a) + w01 * f32::from(b) + w10 * f32::from(c) + w11 * f32::from(d);
         }
     }
     Some(())
+}
+
+thread_local! {
+    /// [`refine_pair`]'s working arrays, kept per thread between calls: a match needs seven
+    /// window-sized arrays, and taking them from here spares their allocation (or the zeroing
+    /// of stack arrays) per match. Every array is written before it is read, so what a previous
+    /// match left in them never matters, and any configured window size gets the same path.
+    static SCRATCH: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
 }
 
 /// Refines one match: `left` / `right` in full-resolution pixels. `None` when rejected.
@@ -88,37 +101,114 @@ pub fn refine_pair(
     right: [f32; 2],
     config: &SubpixelConfig,
 ) -> Option<RefinedPair> {
-    let half = config.half_window as i32;
-    let side = (2 * half + 1) as usize;
-    let n = side * side;
+    let half = i32::try_from(config.half_window).ok()?;
     let (lx, ly) = (left[0].round() as i32, left[1].round() as i32);
     let (w, h) = (left_plane.width() as i32, left_plane.height() as i32);
     if lx - half - 1 < 0 || ly - half - 1 < 0 || lx + half + 1 >= w || ly + half + 1 >= h {
         return None;
     }
-    // Template, its gradient (central differences) and zero-mean form.
-    let mut t = vec![0f32; n];
-    let mut gx = vec![0f32; n];
-    let mut gy = vec![0f32; n];
-    let at = |x: i32, y: i32| left_plane.magnitude()[(y * w + x) as usize] as f32;
-    for r in 0..side {
-        for c in 0..side {
-            let (x, y) = (lx + c as i32 - half, ly + r as i32 - half);
-            let i = r * side + c;
-            t[i] = at(x, y);
-            gx[i] = 0.5 * (at(x + 1, y) - at(x - 1, y));
-            gy[i] = 0.5 * (at(x, y + 1) - at(x, y - 1));
+    // Inside the plane, so the window side is small enough for any arithmetic below.
+    let side = (2 * half + 1) as usize;
+    let len = SCRATCH_ARRAYS * side * side;
+    let mut scratch = SCRATCH.take();
+    if scratch.len() < len {
+        scratch.resize(len, 0.0);
+    }
+    let refined = refine_in(
+        left_plane,
+        right_plane,
+        left,
+        [lx, ly],
+        right,
+        config,
+        &mut scratch[..len],
+    );
+    SCRATCH.set(scratch);
+    refined
+}
+
+/// Window-sized arrays [`refine_in`] works in.
+const SCRATCH_ARRAYS: usize = 7;
+
+/// `values` summed one by one in index order from `+0`. The refinement's reductions are
+/// serial float sums whose order fixes the result bit for bit; the element-wise terms are
+/// computed in a separate pass over whole arrays, which vectorises, and this sum is then all
+/// that remains serial: the same operations in the same order as one loop doing both.
+fn serial_sum(values: &[f32]) -> f32 {
+    values.iter().fold(0.0, |sum, &v| sum + v)
+}
+
+/// Mean of `window` and the norm of its deviations from it, with `squares` (as long as
+/// `window`) for the squared deviations.
+fn mean_and_norm(window: &[f32], squares: &mut [f32]) -> (f32, f32) {
+    let mean = window.iter().sum::<f32>() / window.len() as f32;
+    for (o, &v) in squares.iter_mut().zip(window) {
+        *o = (v - mean).powi(2);
+    }
+    (mean, squares.iter().sum::<f32>().sqrt())
+}
+
+/// [`refine_pair`] with the left point snapped to `[lx, ly]`, whose window plus a one-pixel
+/// border lies inside the plane, and `buffer` [`SCRATCH_ARRAYS`] window sizes long.
+fn refine_in(
+    left_plane: &SobelPlane,
+    right_plane: &SobelPlane,
+    left: [f32; 2],
+    [lx, ly]: [i32; 2],
+    right: [f32; 2],
+    config: &SubpixelConfig,
+    buffer: &mut [f32],
+) -> Option<RefinedPair> {
+    let half = config.half_window as i32;
+    let side = (2 * half + 1) as usize;
+    let n = side * side;
+    // Template, its two gradients, the warped right window and three arrays of terms.
+    let mut arrays = buffer.chunks_exact_mut(n);
+    let [t, gx, gy, warped, p0, p1, p2] =
+        std::array::from_fn(|_| arrays.next().unwrap_or_default());
+    // Template, its gradient (central differences) and zero-mean form. Row slices (the row
+    // with its left and right neighbours, the rows above and below) let the loop run
+    // without bounds checks.
+    let (m, stride) = (left_plane.magnitude(), left_plane.width() as usize);
+    let (x0, y0) = ((lx - half) as usize, (ly - half) as usize);
+    for (r, ((t_row, gx_row), gy_row)) in t
+        .chunks_exact_mut(side)
+        .zip(gx.chunks_exact_mut(side))
+        .zip(gy.chunks_exact_mut(side))
+        .enumerate()
+    {
+        let row = &m[(y0 + r) * stride + x0 - 1..][..side + 2];
+        let above = &m[(y0 + r - 1) * stride + x0..][..side];
+        let below = &m[(y0 + r + 1) * stride + x0..][..side];
+        let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
+        let cells = t_row
+            .iter_mut()
+            .zip(gx_row.iter_mut())
+            .zip(gy_row.iter_mut());
+        for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
+            cells.zip(horizontal).zip(above.iter().zip(below))
+        {
+            *tv = f32::from(c);
+            *gxv = 0.5 * (f32::from(r) - f32::from(l));
+            *gyv = 0.5 * (f32::from(b) - f32::from(a));
         }
     }
     let t_mean = t.iter().sum::<f32>() / n as f32;
     t.iter_mut().for_each(|v| *v -= t_mean);
-    let t_norm = t.iter().map(|v| v * v).sum::<f32>().sqrt();
-    let (mut hxx, mut hxy, mut hyy) = (0f32, 0f32, 0f32);
-    for i in 0..n {
-        hxx += gx[i] * gx[i];
-        hxy += gx[i] * gy[i];
-        hyy += gy[i] * gy[i];
+    for (o, &v) in p0.iter_mut().zip(t.iter()) {
+        *o = v * v;
     }
+    let t_norm = p0.iter().sum::<f32>().sqrt();
+    for ((xx, xy), (yy, (&x, &y))) in p0
+        .iter_mut()
+        .zip(p1.iter_mut())
+        .zip(p2.iter_mut().zip(gx.iter().zip(gy.iter())))
+    {
+        *xx = x * x;
+        *xy = x * y;
+        *yy = y * y;
+    }
+    let (hxx, hxy, hyy) = (serial_sum(p0), serial_sum(p1), serial_sum(p2));
     let det = hxx * hyy - hxy * hxy;
     if det.is_nan() || det <= 1e-6 * (hxx + hyy).powi(2) || t_norm <= 0.0 {
         return None;
@@ -129,26 +219,21 @@ pub fn refine_pair(
         right[1] + (ly as f32 - left[1]),
     ];
     let mut p = start;
-    let mut warped = vec![0f32; n];
     let mut converged = false;
     for _ in 0..config.max_iterations {
-        sample_window(right_plane, p[0], p[1], half, &mut warped)?;
-        let mean = warped.iter().sum::<f32>() / n as f32;
-        let norm = warped
-            .iter()
-            .map(|v| (v - mean).powi(2))
-            .sum::<f32>()
-            .sqrt();
+        sample_window(right_plane, p[0], p[1], half, warped)?;
+        let (mean, norm) = mean_and_norm(warped, p0);
         if norm <= 0.0 {
             return None;
         }
         let gain = t_norm / norm;
-        let (mut bx, mut by) = (0f32, 0f32);
-        for i in 0..n {
-            let e = (warped[i] - mean) * gain - t[i];
-            bx += gx[i] * e;
-            by += gy[i] * e;
+        let errors = warped.iter().zip(t.iter()).zip(gx.iter().zip(gy.iter()));
+        for ((ox, oy), ((&wv, &tv), (&x, &y))) in p0.iter_mut().zip(p1.iter_mut()).zip(errors) {
+            let e = (wv - mean) * gain - tv;
+            *ox = x * e;
+            *oy = y * e;
         }
+        let (bx, by) = (serial_sum(p0), serial_sum(p1));
         // Inverse compositional: Δ = H⁻¹ Σ ∇T·e, p ← p - Δ.
         let dx = (hyy * bx - hxy * by) / det;
         let dy = (hxx * by - hxy * bx) / det;
@@ -168,23 +253,21 @@ pub fn refine_pair(
         return None;
     }
     // Quality at the solution: correlation and the vertical position uncertainty.
-    sample_window(right_plane, p[0], p[1], half, &mut warped)?;
-    let mean = warped.iter().sum::<f32>() / n as f32;
-    let norm = warped
-        .iter()
-        .map(|v| (v - mean).powi(2))
-        .sum::<f32>()
-        .sqrt();
+    sample_window(right_plane, p[0], p[1], half, warped)?;
+    let (mean, norm) = mean_and_norm(warped, p0);
     if norm <= 0.0 {
         return None;
     }
-    let mut dot = 0f32;
-    let mut sse = 0f32;
-    for i in 0..n {
-        let wv = (warped[i] - mean) * t_norm / norm;
-        dot += wv * t[i];
-        sse += (wv - t[i]).powi(2);
+    for ((od, os), (&w, &tv)) in p0
+        .iter_mut()
+        .zip(p1.iter_mut())
+        .zip(warped.iter().zip(t.iter()))
+    {
+        let wv = (w - mean) * t_norm / norm;
+        *od = wv * tv;
+        *os = (wv - tv).powi(2);
     }
+    let (dot, sse) = (serial_sum(p0), serial_sum(p1));
     let ncc = dot / (t_norm * t_norm);
     let noise_var = sse / (n as f32 - 4.0);
     let sigma_v = (noise_var * hxx / det).sqrt();
@@ -198,57 +281,117 @@ pub fn refine_pair(
     })
 }
 
-/// Normalised cross-correlation of the `(2·half+1)²` windows of two planes at integer centres,
-/// `None` when a window leaves its plane or is flat.
-fn ncc_at(
+/// Normalised cross-correlations of the `(2·half+1)²` window of `a` centred on (`ax`, `ay`)
+/// with the windows of `b` centred on (`bx + dx`, `by`) for `dx` in `-search..=search`, in
+/// `dx` order; positions whose window leaves its plane or where either window is flat are left
+/// out.
+///
+/// Every sum is an integer sum, exact in any order, so each value equals a direct per-position
+/// computation bit for bit (see the tests); what differs is that the left window's sums are
+/// taken once, and the right windows' sums come from per-column sums of the search strip
+/// instead of each position's full window, leaving only the cross products per position, taken
+/// over zero-padded copies of the rows in whole vectors.
+/// Up to the default 15x15 window every sum stays below 2^24 (225 products of at most 255²),
+/// so they convert to `f32` exactly; u32 holds them up to windows of 257x257. Products are
+/// taken in `u16` (255² fits), which the compiler vectorises with plain SSE2.
+fn ncc_scan(
     a: &SobelPlane,
-    ax: i32,
-    ay: i32,
+    [ax, ay]: [i32; 2],
     b: &SobelPlane,
-    bx: i32,
-    by: i32,
+    [bx, by]: [i32; 2],
+    search: i32,
     half: i32,
-) -> Option<f32> {
-    let inside = |p: &SobelPlane, x: i32, y: i32| {
+) -> Vec<(i32, f32)> {
+    let mut scores = Vec::new();
+    let [ax, ay, bx, by, search, half] = [ax, ay, bx, by, search, half].map(i64::from);
+    let inside = |p: &SobelPlane, x: i64, y: i64| {
         x - half >= 0
             && y - half >= 0
-            && x + half < p.width() as i32
-            && y + half < p.height() as i32
+            && x + half < i64::from(p.width())
+            && y + half < i64::from(p.height())
     };
-    if !inside(a, ax, ay) || !inside(b, bx, by) {
-        return None;
+    // The right window lies inside its plane for one contiguous range of shifts.
+    let lo = (-search).max(half - bx);
+    let hi = search.min(i64::from(b.width()) - 1 - half - bx);
+    if lo > hi || !inside(a, ax, ay) || !inside(b, bx + lo, by) {
+        return scores;
     }
-    let (wa, wb) = (a.width() as i32, b.width() as i32);
-    let (ma, mb) = (a.magnitude(), b.magnitude());
-    // Integer sums: exact, and loops over `u8` rows the compiler vectorises. Up to the default
-    // 15x15 window every sum stays below 2^24 (225 products of at most 255²), so they convert
-    // to `f32` exactly and the result equals a float accumulation's; u32 holds them up to
-    // windows of 257x257.
-    let (mut sa, mut sb, mut saa, mut sbb, mut sab) = (0u32, 0u32, 0u32, 0u32, 0u32);
     let len = (2 * half + 1) as usize;
-    for dy in -half..=half {
-        let ra = ((ay + dy) * wa + ax - half) as usize;
-        let rb = ((by + dy) * wb + bx - half) as usize;
-        let (Some(row_a), Some(row_b)) = (ma.get(ra..ra + len), mb.get(rb..rb + len)) else {
-            return None;
-        };
-        for (&x, &y) in row_a.iter().zip(row_b) {
-            let (x, y) = (u32::from(x), u32::from(y));
-            sa += x;
-            sb += y;
-            saa += x * x;
-            sbb += y * y;
-            sab += x * y;
+    let row_a = |r: usize| {
+        let start = (ay - half) as usize + r;
+        &a.magnitude()[start * a.width() as usize + (ax - half) as usize..][..len]
+    };
+    let strip_len = (hi - lo) as usize + len;
+    let row_b = |r: usize| {
+        let start = (by - half) as usize + r;
+        &b.magnitude()[start * b.width() as usize + (bx + lo - half) as usize..][..strip_len]
+    };
+    let (mut sa, mut saa) = (0u32, 0u32);
+    for r in 0..len {
+        for &x in row_a(r) {
+            sa += u32::from(x);
+            saa += u32::from(u16::from(x) * u16::from(x));
         }
     }
-    let (sa, sb, saa, sbb, sab) = (sa as f32, sb as f32, saa as f32, sbb as f32, sab as f32);
-    let n = ((2 * half + 1) * (2 * half + 1)) as f32;
-    let va = saa - sa * sa / n;
-    let vb = sbb - sb * sb / n;
-    if va <= 0.0 || vb <= 0.0 {
-        return None;
+    let (mut col_b, mut col_bb) = (vec![0u32; strip_len], vec![0u32; strip_len]);
+    for r in 0..len {
+        for ((s, ss), &y) in col_b.iter_mut().zip(col_bb.iter_mut()).zip(row_b(r)) {
+            *s += u32::from(y);
+            *ss += u32::from(u16::from(y) * u16::from(y));
+        }
     }
-    Some((sab - sa * sb / n) / (va * vb).sqrt())
+    let n = (len * len) as f32;
+    let (sa, saa) = (sa as f32, saa as f32);
+    let va = saa - sa * sa / n;
+    if va <= 0.0 {
+        return scores;
+    }
+    // Copies of the left window's rows and the strip's rows, zero-padded to whole multiples of
+    // `LANES` (the zeros add nothing), so that each row's cross products are whole vectors.
+    let padded = len.div_ceil(LANES) * LANES;
+    let strip_padded = strip_len + padded - len;
+    let mut window_a = vec![0u8; len * padded];
+    let mut strip_b = vec![0u8; len * strip_padded];
+    for (r, (wa, sb)) in window_a
+        .chunks_exact_mut(padded)
+        .zip(strip_b.chunks_exact_mut(strip_padded))
+        .enumerate()
+    {
+        wa[..len].copy_from_slice(row_a(r));
+        sb[..strip_len].copy_from_slice(row_b(r));
+    }
+    for (k, dx) in (lo..=hi).enumerate() {
+        let sb = col_b[k..k + len].iter().sum::<u32>() as f32;
+        let sbb = col_bb[k..k + len].iter().sum::<u32>() as f32;
+        let sab: u32 = window_a
+            .chunks_exact(padded)
+            .zip(strip_b.chunks_exact(strip_padded))
+            .map(|(wa, sb)| dot_u8(wa, &sb[k..k + padded]))
+            .sum();
+        let vb = sbb - sb * sb / n;
+        if vb > 0.0 {
+            scores.push((dx as i32, (sab as f32 - sa * sb / n) / (va * vb).sqrt()));
+        }
+    }
+    scores
+}
+
+/// Vector width (in `u8` pixels) of [`ncc_scan`]'s cross products.
+const LANES: usize = 8;
+
+/// Σ a·b over two equally long rows whose length is a multiple of [`LANES`]: whole chunks of
+/// fixed width, which compile to vector multiplies without a scalar tail. The products are
+/// taken in `u16`, where 255² fits.
+fn dot_u8(a: &[u8], b: &[u8]) -> u32 {
+    a.chunks_exact(LANES)
+        .zip(b.chunks_exact(LANES))
+        .map(|(a, b)| {
+            a.iter()
+                .zip(b)
+                .map(|(&x, &y)| u32::from(u16::from(x) * u16::from(y)))
+                .sum::<u32>()
+        })
+        .sum()
 }
 
 /// Guided matching for a left point without a descriptor match: searches `±search_px`
@@ -263,18 +406,11 @@ pub fn guided_pair(
     search_px: i32,
     config: &SubpixelConfig,
 ) -> Option<RefinedPair> {
-    let half = config.half_window as i32;
+    let half = i32::try_from(config.half_window).ok()?;
     let (lx, ly) = (left[0].round() as i32, left[1].round() as i32);
     let gy = (guess[1] + (ly as f32 - left[1])).round() as i32;
     let gx = (guess[0] + (lx as f32 - left[0])).round() as i32;
-    let scores: Vec<(i32, f32)> = (-search_px..=search_px)
-        .filter_map(|dx| {
-            Some((
-                dx,
-                ncc_at(left_plane, lx, ly, right_plane, gx + dx, gy, half)?,
-            ))
-        })
-        .collect();
+    let scores = ncc_scan(left_plane, [lx, ly], right_plane, [gx, gy], search_px, half);
     let (best_i, &(best_dx, best)) = scores
         .iter()
         .enumerate()
@@ -362,6 +498,126 @@ mod tests {
         .unwrap();
         assert!((got.right[0] - (got.left[0] - 6.4)).abs() < 0.05, "{got:?}");
         assert!((got.right[1] - (got.left[1] + 0.3)).abs() < 0.05, "{got:?}");
+    }
+
+    /// The direct per-position correlation [`ncc_scan`] must reproduce bit for bit.
+    fn ncc_at(
+        a: &SobelPlane,
+        [ax, ay]: [i32; 2],
+        b: &SobelPlane,
+        [bx, by]: [i32; 2],
+        half: i32,
+    ) -> Option<f32> {
+        let inside = |p: &SobelPlane, x: i32, y: i32| {
+            x - half >= 0
+                && y - half >= 0
+                && x + half < p.width() as i32
+                && y + half < p.height() as i32
+        };
+        if !inside(a, ax, ay) || !inside(b, bx, by) {
+            return None;
+        }
+        let (mut sa, mut sb, mut saa, mut sbb, mut sab) = (0u32, 0u32, 0u32, 0u32, 0u32);
+        for dy in -half..=half {
+            for dx in -half..=half {
+                let x = u32::from(a.get(ax + dx, ay + dy)?.0);
+                let y = u32::from(b.get(bx + dx, by + dy)?.0);
+                sa += x;
+                sb += y;
+                saa += x * x;
+                sbb += y * y;
+                sab += x * y;
+            }
+        }
+        let (sa, sb, saa, sbb, sab) = (sa as f32, sb as f32, saa as f32, sbb as f32, sab as f32);
+        let n = ((2 * half + 1) * (2 * half + 1)) as f32;
+        let va = saa - sa * sa / n;
+        let vb = sbb - sb * sb / n;
+        if va <= 0.0 || vb <= 0.0 {
+            return None;
+        }
+        Some((sab - sa * sb / n) / (va * vb).sqrt())
+    }
+
+    #[test]
+    fn scan_equals_the_direct_correlation_at_every_shift() {
+        let l = plane(60, 40, 0.0, 0.0, 1.0);
+        let r = plane(60, 40, -4.6, 0.4, 0.8);
+        // A right plane with a flat band, so some windows are flat and left out.
+        let mut mag = r.magnitude().to_vec();
+        mag.iter_mut()
+            .enumerate()
+            .filter(|(i, _)| (20..34).contains(&(i % 60)))
+            .for_each(|(_, v)| *v = 77);
+        let banded = SobelPlane::new(0, 60, 40, mag, vec![0; 2400]).unwrap();
+        let mut compared = 0;
+        for right in [&r, &banded] {
+            for half in [1, 3, 7] {
+                // Centres near and beyond every border, so windows leave the planes.
+                for &(lx, ly, gx, gy) in &[
+                    (30, 20, 26, 20),
+                    (5, 7, 2, 8),
+                    (55, 33, 58, 32),
+                    (30, 2, 30, 20),
+                    (30, 20, 30, 38),
+                    (30, 20, -9, 20),
+                    (30, 20, 70, 20),
+                    (40, 20, 27, 21),
+                ] {
+                    for search in [-1, 0, 4, 9] {
+                        let got = ncc_scan(&l, [lx, ly], right, [gx, gy], search, half);
+                        let want: Vec<(i32, f32)> = (-search..=search)
+                            .filter_map(|dx| {
+                                Some((dx, ncc_at(&l, [lx, ly], right, [gx + dx, gy], half)?))
+                            })
+                            .collect();
+                        let bits = |v: &[(i32, f32)]| {
+                            v.iter().map(|&(d, c)| (d, c.to_bits())).collect::<Vec<_>>()
+                        };
+                        assert_eq!(
+                            bits(&got),
+                            bits(&want),
+                            "{lx} {ly} {gx} {gy} {search} {half}"
+                        );
+                        compared += want.len();
+                    }
+                }
+            }
+        }
+        assert!(compared > 300, "only {compared} correlations compared");
+    }
+
+    #[test]
+    fn stale_scratch_and_large_or_impossible_windows() {
+        let l = plane(120, 90, 0.0, 0.0, 1.0);
+        let r = plane(120, 90, -3.37, 0.21, 0.9);
+        let default = SubpixelConfig::default();
+        let first = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &default).unwrap();
+        // A larger window grows this thread's scratch arrays and leaves its values in them.
+        let config = SubpixelConfig {
+            half_window: 12,
+            ..default
+        };
+        let got = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &config).unwrap();
+        assert!(
+            (got.right[0] - (got.left[0] - 3.37)).abs() < 0.05,
+            "{got:?}"
+        );
+        assert!(
+            (got.right[1] - (got.left[1] + 0.21)).abs() < 0.05,
+            "{got:?}"
+        );
+        let again = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &default).unwrap();
+        assert_eq!(format!("{first:?}"), format!("{again:?}"));
+        // Windows that cannot fit the plane, however large the configured value, are rejected.
+        for half_window in [60, usize::MAX] {
+            let config = SubpixelConfig {
+                half_window,
+                ..default
+            };
+            assert!(refine_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], &config).is_none());
+            assert!(guided_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], 4, &config).is_none());
+        }
     }
 
     #[test]
