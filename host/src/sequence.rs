@@ -70,23 +70,23 @@ pub enum SequenceError {
 
 impl GrayFrame {
     /// The top-left `width` x `height` window (the origin stays, so the intrinsics still
-    /// hold); `None` when the window is larger than the frame.
-    pub fn cropped(&self, width: usize, height: usize) -> Option<GrayFrame> {
+    /// hold); `None` when the window is larger than the frame. A frame that is the window
+    /// already is returned as it is, and the rows of a smaller one move in place, so a pair
+    /// costs no copy on its way to the device.
+    pub fn cropped(mut self, width: usize, height: usize) -> Option<GrayFrame> {
         if width > self.width || height > self.height {
             return None;
         }
-        let pixels = self
-            .pixels
-            .chunks_exact(self.width)
-            .take(height)
-            .flat_map(|row| &row[..width])
-            .copied()
-            .collect();
-        Some(GrayFrame {
-            width,
-            height,
-            pixels,
-        })
+        if width != self.width {
+            for row in 1..height {
+                let from = row * self.width;
+                self.pixels.copy_within(from..from + width, row * width);
+            }
+        }
+        self.pixels.truncate(width * height);
+        self.width = width;
+        self.height = height;
+        Some(self)
     }
 }
 
@@ -270,6 +270,25 @@ pub fn decode_gray(bytes: &[u8], path_for_errors: &Path) -> Result<GrayFrame, Se
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cropping_keeps_the_top_left_window() {
+        let frame = |w: usize, h: usize| GrayFrame {
+            width: w,
+            height: h,
+            pixels: (0..w * h).map(|i| (i % 251) as u8).collect(),
+        };
+        let window = frame(5, 4).cropped(3, 2).unwrap();
+        assert_eq!((window.width, window.height), (3, 2));
+        assert_eq!(window.pixels, [0, 1, 2, 5, 6, 7]);
+        assert_eq!(frame(5, 4).cropped(5, 4), Some(frame(5, 4)));
+        assert_eq!(
+            frame(5, 4).cropped(5, 3).unwrap().pixels,
+            frame(5, 3).pixels
+        );
+        assert_eq!(frame(5, 4).cropped(6, 4), None);
+        assert_eq!(frame(5, 4).cropped(5, 5), None);
+    }
 
     const LIMITS: SizeLimits = SizeLimits {
         max_width: 64,

@@ -69,13 +69,13 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let (first, _) = sequence.pair(0, None)?;
-    let size = (first.width, first.height);
+    let first = sequence.pair(0, None)?;
+    let size = (first.0.width, first.0.height);
     anyhow::ensure!(
-        first.height <= MAX_HEIGHT as usize,
+        size.1 <= MAX_HEIGHT as usize,
         "frame 0: image is {}x{}; the fabric takes at most {MAX_HEIGHT} lines",
-        first.width,
-        first.height
+        size.0,
+        size.1
     );
     // Every octave must have whole pixels, so the fabric's window is a multiple of
     // 2^(octaves-1) on each side; like a grabber's region of interest it starts at the
@@ -98,9 +98,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         let (tx, rx) = mpsc::sync_channel::<anyhow::Result<(GrayFrame, GrayFrame)>>(LOOKAHEAD);
         let sequence = &sequence;
         scope.spawn(move || {
+            // Frame 0 is decoded already (for the size); the others are decoded here, ahead.
+            let mut first = Some(first);
             for frame in 0..sequence.len() {
-                let pair = sequence
-                    .pair(frame, Some(size))
+                let pair = first
+                    .take()
+                    .map_or_else(|| sequence.pair(frame, Some(size)), Ok)
                     .map_err(anyhow::Error::from)
                     .and_then(|(l, r)| {
                         l.cropped(window.0, window.1)
