@@ -1,15 +1,17 @@
-//! COBS encoding and decoding inside one buffer, block by block instead of byte by byte.
+//! COBS encoding and decoding inside one buffer, a word or a code byte at a time instead of a
+//! byte at a time.
 //!
 //! The output is byte for byte that of the `cobs` crate (the proptests below compare them),
 //! but the `cobs` crate's state machine spends a match and a bounds check on every byte, and
-//! the host frames every byte of a full-Sobel stream (2.6 MB per 1264x376 pair). Here the
-//! common case moves no data at all: while no block is full (254 non-zero bytes), COBS only
-//! replaces each `0x00` by the distance to the next one and puts one code byte in front, so
-//! with the packet one byte behind the code slot the encoder is a backward pass over the bytes
-//! and the decoder a walk along the codes (a flat stretch of `0x01` codes at a word a time).
-//! Only full blocks shift data, by one byte each.
+//! the host frames every byte of a full-Sobel stream (2.6 MB per 1264x376 pair, in blocks of
+//! about 11 bytes: per-block work is what counts). Here the common case moves no data at all:
+//! while no block is full (254 non-zero bytes), COBS only replaces each `0x00` by the distance
+//! to the next one and puts one code byte in front, so with the packet one byte behind the
+//! code slot the encoder writes one code per zero it finds and the decoder writes one zero per
+//! code it follows. Only full blocks shift data, by one byte each, and only from the first
+//! full block on does either side fall back to moving bytes.
 //!
-//! Every access is checked (`get`/`get_mut`, iterators, cells), so the firmware links no
+//! Every access is checked (`get`, iterators, cells), so the firmware links no
 //! panicking path through here (tests/tests/firmware_panic_free.rs).
 
 use core::cell::Cell;
@@ -18,100 +20,220 @@ use core::ops::Range;
 /// Most non-zero bytes one COBS block carries (its code byte is then `0xFF`).
 const FULL_BLOCK: usize = 254;
 
-/// Chunk size of the search for long runs: a run of `FULL_BLOCK` or more non-zero bytes always
-/// covers one whole chunk of `FULL_BLOCK / 2` (aligned to where the search starts), so only
-/// chunks without a zero need a closer look.
-const CHUNK: usize = FULL_BLOCK / 2;
+/// The code byte of a full block.
+const FULL_CODE: u8 = FULL_BLOCK as u8 + 1;
 
 /// COBS-encodes `buf[src..src + len]` into `buf[..]` and returns the encoded length, or
 /// `None` when `src` is 0 or `buf` is too short (shorter than the encoding), which
 /// [`crate::encode`] rules out.
 ///
-/// The packet is first moved to `1 + E`, `E` the code bytes its full blocks insert: with
-/// `src == 1` (as [`crate::encode`] places it) it stays put unless there are full blocks.
-/// Every inserted code byte then closes the gap between output and input by one, so the
-/// output never overtakes input not yet read, and after the last full block the data is where
-/// it belongs. Between full blocks the encoding is one backward pass per stretch.
+/// The packet is moved to index 1 (where [`crate::encode`] already puts it), behind the slot
+/// of the first code byte. Each `0x00` then becomes the code of the block after it, the
+/// distance to the next `0x00` (or to the end), and the slot in front the distance to the
+/// first: a forward scan that writes each code when it finds the zero that ends the block.
+/// The zeros are found a machine word at a time ([`zero_bytes`]) and taken lowest first, so the
+/// cost is per word and per zero, not per byte (`memchr` per block was a call per ~11 bytes on
+/// Sobel rows); an all-zero word, common in flat image regions, is one store of `0x01`s. The
+/// bytes are read and written through cells, so one pass over the words can write the codes
+/// behind it. A block longer than [`FULL_BLOCK`] needs inserted code bytes, which
+/// [`Blocks::insert_full`] makes room for.
 pub(crate) fn encode_in_place(buf: &mut [u8], src: usize, len: usize) -> Option<usize> {
     if src == 0 {
         return None;
     }
-    let end = 1 + extra_codes(buf.get(src..src.checked_add(len)?)?) + len;
-    let mut read = end - len;
-    move_bytes(buf, src, read, len)?;
-    // `slot` is the current block's code byte, `out` where the next data byte goes.
-    let mut slot = 0;
-    let mut out = 1;
-    while let Some(run) = long_run(buf.get(read..end)?) {
-        let (run_start, run_end) = (read + run.start, read + run.end);
-        if run_start > read {
-            // The stretch up to the zero before the run; that zero's place is the next slot.
-            let stretch = run_start - 1 - read;
-            move_bytes(buf, read, out, stretch)?;
-            encode_stretch(buf.get_mut(slot..out + stretch)?);
-            slot = out + stretch;
-            out = slot + 1;
-            read = run_start;
-        }
-        while run_end - read >= FULL_BLOCK {
-            *buf.get_mut(slot)? = 0xff;
-            move_bytes(buf, read, out, FULL_BLOCK)?;
-            read += FULL_BLOCK;
-            out += FULL_BLOCK;
-            if read == end {
-                // COBS drops the empty block after a final full one.
-                return Some(out);
+    let cells = Cell::from_mut(buf).as_slice_of_cells();
+    move_bytes(cells, src, 1, len)?;
+    let mut blocks = Blocks {
+        slot: 0,
+        head: 0,
+        gap: 0,
+        end: len.checked_add(1)?,
+    };
+    let mut from = 1;
+    'scan: loop {
+        let mut words = cells.get(from..blocks.end)?.chunks_exact(WORD);
+        let mut base = from;
+        for word in &mut words {
+            let zeros = zero_bytes(load(word));
+            if zeros != 0 {
+                if let Some(moved_to) = blocks.close_word(cells, base, zeros)? {
+                    from = moved_to;
+                    continue 'scan;
+                }
             }
-            slot = out;
-            out += 1;
+            base += WORD;
         }
+        // The last, partial word, padded with non-zero bytes.
+        let mut last = [0xff; WORD];
+        for (to, from) in last.iter_mut().zip(words.remainder()) {
+            *to = from.get();
+        }
+        let zeros = zero_bytes(usize::from_le_bytes(last));
+        if zeros != 0 {
+            if let Some(moved_to) = blocks.close_word(cells, base, zeros)? {
+                from = moved_to;
+                continue 'scan;
+            }
+        }
+        break;
     }
-    let tail = end - read;
-    move_bytes(buf, read, out, tail)?;
-    encode_stretch(buf.get_mut(slot..out + tail)?);
-    Some(out + tail)
+    // A full last block (code 0xFF) ends the frame: COBS drops the empty block after it.
+    let end = blocks.end;
+    if end - blocks.slot > usize::from(FULL_CODE) {
+        blocks.insert_full(cells, end, usize::from(FULL_CODE))?;
+    }
+    let end = blocks.end;
+    cells.get(blocks.slot)?.set((end - blocks.slot) as u8);
+    Some(end)
 }
 
-/// Code bytes the full blocks of `data` insert (a full block at the very end inserts none:
-/// COBS drops the empty block after it). Walks the long runs as [`encode_in_place`] does.
-fn extra_codes(data: &[u8]) -> usize {
-    let mut read = 0;
+/// The state of [`encode_in_place`]. Positions are where the bytes are now; the encoding of a
+/// byte at `p` goes to `p - gap`.
+///
+/// Until the first full block `gap` is 0 and nothing moves. There, the rest of the packet
+/// moves `E` bytes towards the end, `E` the code bytes its full blocks insert
+/// ([`extra_codes`]), and the scan starts again in the moved bytes. Each inserted code closes
+/// the gap by one: the stretch since the last one (codes written in place) moves down to
+/// where it belongs, once, and its last byte, now read, becomes the slot of the code after
+/// the full block. After the last full block `gap` is 0 again, so nothing after it moves.
+struct Blocks {
+    /// Where the current block's code byte goes (its final place is `slot - gap`).
+    slot: usize,
+    /// Start of the stretch not yet moved to its final place (its first byte is a code).
+    head: usize,
+    /// Code bytes still to insert.
+    gap: usize,
+    /// End of the packet.
+    end: usize,
+}
+
+impl Blocks {
+    /// Ends a block at each zero of the word at `base` (`zeros` its [`zero_bytes`] mask).
+    /// `Some(Some(p))` when the first full block moved the rest of the packet: the scan goes on
+    /// at `p`, just after the zero that made room for it.
+    #[inline(always)]
+    fn close_word(
+        &mut self,
+        cells: &[Cell<u8>],
+        base: usize,
+        zeros: usize,
+    ) -> Option<Option<usize>> {
+        let mut slot = self.slot;
+        if zeros == HIGHS && base - slot <= FULL_BLOCK {
+            // A flat word: its first zero ends the block before, each of the others an
+            // empty block, so the word becomes `01 01 .. 01` and its last byte the slot.
+            cells.get(slot)?.set((base - slot) as u8);
+            for cell in cells.get(base..base + WORD - 1)? {
+                cell.set(1);
+            }
+            self.slot = base + WORD - 1;
+            return Some(None);
+        }
+        let mut zeros = zeros;
+        while zeros != 0 {
+            let zero = base + (zeros.trailing_zeros() / 8) as usize;
+            zeros &= zeros - 1;
+            if zero - slot > FULL_BLOCK {
+                self.slot = slot;
+                if let Some(moved_to) = self.insert_full_at(cells, zero)? {
+                    return Some(Some(moved_to));
+                }
+                slot = self.slot;
+            }
+            cells.get(slot)?.set((zero - slot) as u8);
+            slot = zero;
+        }
+        self.slot = slot;
+        Some(None)
+    }
+
+    /// [`close_word`](Self::close_word) at a `zero` too far from the slot: inserts the full
+    /// blocks and, when that moved the packet, ends the block at the moved zero and returns
+    /// where the scan goes on.
+    #[cold]
+    fn insert_full_at(&mut self, cells: &[Cell<u8>], zero: usize) -> Option<Option<usize>> {
+        let moved = self.insert_full(cells, zero, FULL_BLOCK)?;
+        if moved == 0 {
+            return Some(None);
+        }
+        let zero = zero + moved;
+        cells.get(self.slot)?.set((zero - self.slot) as u8);
+        self.slot = zero;
+        Some(Some(zero + 1))
+    }
+
+    /// Inserts full blocks until `at` (a zero or the end of the packet) is at most `most`
+    /// bytes from the slot; the first ever moves the rest of the packet to make room for all
+    /// of them, and the move is returned.
+    fn insert_full(&mut self, cells: &[Cell<u8>], at: usize, most: usize) -> Option<usize> {
+        let mut moved = 0;
+        if self.gap == 0 {
+            let rest = self.slot + 1;
+            moved = extra_codes(cells.get(rest..self.end)?);
+            move_bytes(cells, rest, rest + moved, self.end - rest)?;
+            self.gap = moved;
+            self.end += moved;
+            // The slot's old byte was moved, so the slot can stand in the freed room at the
+            // head of the stretch that moves down at the first insertion.
+            self.slot += moved;
+            self.head = self.slot;
+        }
+        let at = at + moved;
+        while at - self.slot > most {
+            cells.get(self.slot)?.set(FULL_CODE);
+            let block_end = self.slot + 1 + FULL_BLOCK;
+            move_bytes(
+                cells,
+                self.head,
+                self.head - self.gap,
+                block_end - self.head,
+            )?;
+            self.gap -= 1;
+            self.slot = block_end - 1;
+            self.head = self.slot;
+        }
+        Some(moved)
+    }
+}
+
+/// Code bytes the full blocks of `data` insert: a zero-free run of `r` bytes holds
+/// `r / FULL_BLOCK` full blocks, each followed by a code of its own (a block ended by a zero
+/// has the zero's place for the next code), except a full block at the very end, after which
+/// COBS drops the empty block. Only runs that span words can be that long, so each word with a
+/// zero only ends the run before its first zero and starts one after its last.
+fn extra_codes(data: &[Cell<u8>]) -> usize {
     let mut extra = 0;
-    while let Some(run) = data.get(read..).and_then(long_run) {
-        let len = run.end - run.start;
-        let full = len / FULL_BLOCK;
-        let at_end = read + run.end == data.len() && len % FULL_BLOCK == 0;
-        extra += full - usize::from(at_end);
-        read += run.start + full * FULL_BLOCK;
+    let mut run_start = 0;
+    let mut words = data.chunks_exact(WORD);
+    let mut base = 0;
+    for word in &mut words {
+        let zeros = zero_bytes(load(word));
+        if zeros != 0 {
+            let first = base + (zeros.trailing_zeros() / 8) as usize;
+            extra += (first - run_start) / FULL_BLOCK;
+            run_start = base + ((usize::BITS - 1 - zeros.leading_zeros()) / 8) as usize + 1;
+        }
+        base += WORD;
     }
-    extra
+    for byte in words.remainder() {
+        if byte.get() == 0 {
+            extra += (base - run_start) / FULL_BLOCK;
+            run_start = base + 1;
+        }
+        base += 1;
+    }
+    let run = base - run_start;
+    extra + run / FULL_BLOCK - usize::from(run != 0 && run % FULL_BLOCK == 0)
 }
 
-/// The first run of at least [`FULL_BLOCK`] non-zero bytes in `bytes` (bounded by zeros or
-/// the ends of `bytes`), if any. The chunk test is `contains`, a word-at-a-time `memchr`, so
-/// zero-rich and textured data are both scanned quickly.
-fn long_run(bytes: &[u8]) -> Option<Range<usize>> {
-    let mut chunk_start = 0;
-    while let Some(chunk) = bytes.get(chunk_start..chunk_start + CHUNK) {
-        if chunk.contains(&0) {
-            chunk_start += CHUNK;
-            continue;
-        }
-        // The chunk before held a zero (or this run would have been found there), so this
-        // looks back less than one chunk.
-        let before = bytes.get(..chunk_start).unwrap_or_default();
-        let start = before
-            .iter()
-            .rposition(|&byte| byte == 0)
-            .map_or(0, |zero| zero + 1);
-        let end = chunk_start + first_zero(bytes.get(chunk_start..).unwrap_or_default());
-        if end - start >= FULL_BLOCK {
-            return Some(start..end);
-        }
-        // Continue at the chunk holding the zero that ended this short run.
-        chunk_start += (end - chunk_start) / CHUNK * CHUNK;
+/// The little-endian word in `cells` (`WORD` of them), one load once optimised.
+#[inline(always)]
+fn load(cells: &[Cell<u8>]) -> usize {
+    let mut bytes = [0; WORD];
+    for (byte, cell) in bytes.iter_mut().zip(cells) {
+        *byte = cell.get();
     }
-    None
+    usize::from_le_bytes(bytes)
 }
 
 /// Bytes in a machine word, the step of the scans below.
@@ -120,6 +242,17 @@ const WORD: usize = core::mem::size_of::<usize>();
 const ONES: usize = usize::MAX / 0xff;
 /// `0x80` in every byte of a word.
 const HIGHS: usize = ONES << 7;
+/// `0x7F` in every byte of a word.
+const LOWS: usize = !HIGHS;
+
+/// `0x80` in each byte of `word` that is `0x00`, `0x00` in the others, exactly: adding
+/// `0x7F` to the low seven bits of a byte sets its top bit unless they are all clear, and
+/// cannot carry into the next byte; OR-ing the byte's own top bit in leaves it clear only for
+/// `0x00`. (The shorter `(w - 0x01..01) & !w` borrows across bytes and can flag a `0x01`
+/// above a zero, fine for [`first_zero`] but not for finding every zero.)
+fn zero_bytes(word: usize) -> usize {
+    !(((word & LOWS) + LOWS) | word) & HIGHS
+}
 
 /// Index of the first `0x00` in `bytes`, or its length.
 ///
@@ -145,135 +278,70 @@ pub(crate) fn first_zero(bytes: &[u8]) -> usize {
             .unwrap_or(tail.len())
 }
 
-/// Number of `0x01` bytes at the start of `bytes`, a machine word at a time: XOR with
-/// `0x01..01` clears exactly those, and the lowest set bit left marks the first other byte.
-fn leading_ones(bytes: &[u8]) -> usize {
-    let mut words = bytes.chunks_exact(WORD);
-    let mut count = 0;
-    for word in &mut words {
-        let others = usize::from_le_bytes(word.try_into().unwrap_or_default()) ^ ONES;
-        if others != 0 {
-            return count + (others.trailing_zeros() / 8) as usize;
-        }
-        count += WORD;
-    }
-    let tail = words.remainder();
-    count
-        + tail
-            .iter()
-            .position(|&byte| byte != 1)
-            .unwrap_or(tail.len())
-}
-
-/// Encodes a stretch without full blocks in place: `block[0]` is its code byte's slot and
-/// `block[1..]` its data, ended by a zero just past `block` or by the packet's end. Walking
-/// backwards, each `0x00` becomes the distance to the next zero (or to the end of `block`),
-/// and `block[0]` the distance to the first; no byte moves. A word at a time where it can:
-/// textured words (no zero) only add to the distance, flat words (all zero) become
-/// `01 01 .. distance`; only the words that mix the two go byte by byte.
-fn encode_stretch(block: &mut [u8]) {
-    let Some((code, data)) = block.split_first_mut() else {
-        return;
-    };
-    let mut distance: u8 = 1;
-    let mut words = data.rchunks_exact_mut(WORD);
-    for word in &mut words {
-        let value = usize::from_le_bytes((&*word).try_into().unwrap_or_default());
-        if value.wrapping_sub(ONES) & !value & HIGHS == 0 {
-            // At most FULL_BLOCK: the stretch holds no zero-free run of FULL_BLOCK bytes.
-            distance = distance.wrapping_add(WORD as u8);
-        } else if value == 0 {
-            let mut flat = [1u8; WORD];
-            flat[WORD - 1] = distance;
-            for (byte, value) in word.iter_mut().zip(flat) {
-                *byte = value;
-            }
-            distance = 1;
-        } else {
-            distance = encode_bytes(word, distance);
-        }
-    }
-    *code = encode_bytes(words.into_remainder(), distance);
-}
-
-/// [`encode_stretch`] byte by byte: turns the zeros of `bytes` into distances, given the
-/// distance from its end to the next zero, and returns the distance from its start.
-fn encode_bytes(bytes: &mut [u8], mut distance: u8) -> u8 {
-    for byte in bytes.iter_mut().rev() {
-        if *byte == 0 {
-            *byte = distance;
-            distance = 1;
-        } else {
-            distance = distance.wrapping_add(1);
-        }
-    }
-    distance
-}
-
 /// COBS-decodes `buf` (no `0x00` in it) in place and returns where the decoded bytes are, or
-/// `None` when a code byte points past the end: the transform and the rejections of
-/// `cobs::decode_in_place`. The decoded bytes start at index 1, where the first block's data
-/// already is, so a frame without full blocks decodes by turning each later code byte back
-/// into `0x00`; after each full block the rest moves one byte towards the front.
+/// `None` when a code byte is `0x00` or points past the end: the transform and the rejections
+/// of `cobs::decode_in_place`.
+///
+/// The decoded bytes start at index 1, where the first block's data already is. Each code
+/// byte after the first stands where the zero that ended the block before it belongs, so the
+/// walk along the codes only turns each one into `0x00`, one load and one store per block,
+/// and a flat stretch of `0x01` codes (empty blocks) a word at a time. A full block has no zero
+/// after it: its successor's code is dropped instead, and the bytes after it belong one
+/// further down. They are decoded in place all the same and moved down once per stretch, when
+/// the next dropped code (or the end) closes it, so nothing before the first full block moves.
 pub(crate) fn decode_in_place(buf: &mut [u8]) -> Option<Range<usize>> {
     let end = buf.len();
+    let cells = Cell::from_mut(buf).as_slice_of_cells();
     let mut code_at = 0;
-    let mut code = *buf.first()?;
-    let mut dest = 1;
+    let mut code = cells.first()?.get();
+    // Codes dropped so far, and the start of the decoded bytes not yet moved down by as many.
+    let mut dropped = 0;
+    let mut unmoved = 1;
     loop {
-        if code == 1 {
-            // A flat stretch: a row of `0x01` codes, each an empty block and so one zero. Done
-            // as one fill, not one dependent load per byte.
-            // (`buf[code_at]` itself may already hold the previous block's zero.)
-            let codes = 1 + leading_ones(buf.get(code_at + 1..)?);
-            let after = code_at + codes;
-            if after == end {
-                // The last code ends the frame and adds no zero.
-                buf.get_mut(dest..dest + codes - 1)?.fill(0);
-                return Some(1..dest + codes - 1);
+        let mut next = code_at + usize::from(code);
+        if code == 0 || next >= end {
+            if code == 0 || next > end {
+                return None;
             }
-            code = *buf.get(after)?;
-            buf.get_mut(dest..dest + codes)?.fill(0);
-            dest += codes;
-            code_at = after;
-            continue;
+            move_bytes(cells, unmoved, unmoved - dropped, end - unmoved)?;
+            return Some(1..end - dropped);
         }
-        let code_len = usize::from(code);
-        if code_len == 0 {
-            return None;
+        if code == 1 {
+            // Whole words of `0x01` codes before the last code: empty blocks, all zeros.
+            while next + WORD < end {
+                let word = cells.get(next..next + WORD)?;
+                if load(word) != ONES {
+                    break;
+                }
+                for cell in word {
+                    cell.set(0);
+                }
+                next += WORD;
+            }
         }
-        let block_end = code_at + code_len;
-        if block_end > end {
-            return None;
+        let place = cells.get(next)?;
+        let full = code == FULL_CODE;
+        code = place.get();
+        if full {
+            move_bytes(cells, unmoved, unmoved - dropped, next - unmoved)?;
+            dropped += 1;
+            unmoved = next + 1;
+        } else {
+            place.set(0);
         }
-        let data_len = code_len - 1;
-        if dest != code_at + 1 && data_len != 0 {
-            move_bytes(buf, code_at + 1, dest, data_len)?;
-        }
-        dest += data_len;
-        if block_end == end {
-            return Some(1..dest);
-        }
-        // Read the next code before the zero below may land on it.
-        code = *buf.get(block_end)?;
-        code_at = block_end;
-        if code_len != FULL_BLOCK + 1 {
-            *buf.get_mut(dest)? = 0;
-            dest += 1;
-        }
+        code_at = next;
     }
 }
 
-/// Moves `buf[from..from + len]` to `buf[to..to + len]`, overlapping or not, like
+/// Moves `cells[from..from + len]` to `cells[to..to + len]`, overlapping or not, like
 /// `copy_within`, but as a loop over cells: `copy_within` and `rotate_left` each left a
 /// bounds-check panic in the firmware's release ELF (not inlined there, so no guard here could
-/// discharge it), and `Cell` lets one loop read and write the same bytes without indexing.
+/// discharge it), and cells let one loop read and write the same bytes without indexing.
 /// Copying in the direction of the move reads every byte before it is overwritten.
-fn move_bytes(buf: &mut [u8], from: usize, to: usize, len: usize) -> Option<()> {
+fn move_bytes(cells: &[Cell<u8>], from: usize, to: usize, len: usize) -> Option<()> {
     if from == to {
         return Some(());
     }
-    let cells = Cell::from_mut(buf).as_slice_of_cells();
     let source = cells.get(from..from.checked_add(len)?)?;
     let target = cells.get(to..to.checked_add(len)?)?;
     if to < from {
