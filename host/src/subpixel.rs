@@ -130,12 +130,21 @@ pub fn refine_pair(
 /// Window-sized arrays [`refine_in`] works in.
 const SCRATCH_ARRAYS: usize = 7;
 
-/// `values` summed one by one in index order from `+0`. The refinement's reductions are
-/// serial float sums whose order fixes the result bit for bit; the element-wise terms are
-/// computed in a separate pass over whole arrays, which vectorises, and this sum is then all
-/// that remains serial: the same operations in the same order as one loop doing both.
-fn serial_sum(values: &[f32]) -> f32 {
-    values.iter().fold(0.0, |sum, &v| sum + v)
+/// Each of `arrays` summed one by one in index order from `+0`. The refinement's reductions
+/// are serial float sums whose order fixes the result bit for bit; the element-wise terms are
+/// computed in a separate pass over whole arrays, which vectorises, and these sums are then
+/// all that remains serial: the same operations in the same order as one loop doing both.
+/// A serial sum waits on its previous add at every element, so the sums the refinement needs
+/// together run side by side here, each its own chain, in the time of one.
+fn serial_sums<const K: usize>(arrays: [&[f32]; K]) -> [f32; K] {
+    let n = arrays.iter().map(|a| a.len()).min().unwrap_or(0);
+    let mut sums = [0.0f32; K];
+    for i in 0..n {
+        for (sum, array) in sums.iter_mut().zip(&arrays) {
+            *sum += array[i];
+        }
+    }
+    sums
 }
 
 /// Mean of `window` and the norm of its deviations from it, with `squares` (as long as
@@ -208,7 +217,7 @@ fn refine_in(
         *xy = x * y;
         *yy = y * y;
     }
-    let (hxx, hxy, hyy) = (serial_sum(p0), serial_sum(p1), serial_sum(p2));
+    let [hxx, hxy, hyy] = serial_sums([&*p0, &*p1, &*p2]);
     let det = hxx * hyy - hxy * hxy;
     if det.is_nan() || det <= 1e-6 * (hxx + hyy).powi(2) || t_norm <= 0.0 {
         return None;
@@ -233,7 +242,7 @@ fn refine_in(
             *ox = x * e;
             *oy = y * e;
         }
-        let (bx, by) = (serial_sum(p0), serial_sum(p1));
+        let [bx, by] = serial_sums([&*p0, &*p1]);
         // Inverse compositional: Δ = H⁻¹ Σ ∇T·e, p ← p - Δ.
         let dx = (hyy * bx - hxy * by) / det;
         let dy = (hxx * by - hxy * bx) / det;
@@ -267,7 +276,7 @@ fn refine_in(
         *od = wv * tv;
         *os = (wv - tv).powi(2);
     }
-    let (dot, sse) = (serial_sum(p0), serial_sum(p1));
+    let [dot, sse] = serial_sums([&*p0, &*p1]);
     let ncc = dot / (t_norm * t_norm);
     let noise_var = sse / (n as f32 - 4.0);
     let sigma_v = (noise_var * hxx / det).sqrt();
