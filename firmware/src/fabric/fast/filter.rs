@@ -18,6 +18,15 @@ macro_rules! kernel {
         $(#[$doc])*
         pub fn $name($($arg: $ty),*) {
             #[cfg(target_arch = "x86_64")]
+            if crate::fabric::fast::simd::has_avx512() {
+                #[target_feature(enable = "avx512f,avx512bw")]
+                unsafe fn wider($($arg: $ty),*) {
+                    $body($($arg),*)
+                }
+                // SAFETY: `wider` needs only AVX-512F/BW, which the CPU was just found to have.
+                return unsafe { wider($($arg),*) };
+            }
+            #[cfg(target_arch = "x86_64")]
             if crate::fabric::fast::simd::has_avx2() {
                 #[target_feature(enable = "avx2")]
                 unsafe fn wide($($arg: $ty),*) {
