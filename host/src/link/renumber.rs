@@ -86,8 +86,10 @@ fn cobs_layout(encoded: &[u8]) -> Option<(usize, usize)> {
     }
 }
 
-/// Bytes of zeros the CRC difference is carried through at most (one arm of a frame).
-const ZEROS: [u8; stereocal_wire::MAX_FRAME_LEN] = [0; stereocal_wire::MAX_FRAME_LEN];
+/// Bytes of zeros the CRC difference is carried through at most per step (a frame's
+/// length). A `static`, so every use reads the one array: a `const` sliced at a run-time
+/// length may be built afresh as a temporary at each use.
+static ZEROS: [u8; stereocal_wire::MAX_FRAME_LEN] = [0; stereocal_wire::MAX_FRAME_LEN];
 
 /// The CRC register difference `x` after `len` more equal bytes: zeros carry the register
 /// linearly, and `crc32c_append` starts from and returns the complement of the register.
