@@ -24,7 +24,7 @@ fn frame<F: FrontEnd>(fe: &mut F, cfg: &Config, img: &[u8]) -> usize {
     let mut m = 0usize;
     // The consumer touches every item (as the driver's packetizer would).
     run_frame(fe, cfg, img, &mut |p| n += p.len(), &mut |s| {
-        m += s.iter().map(|s| s.magnitude as usize).sum::<usize>()
+        m += s.magnitude.iter().map(|&m| m as usize).sum::<usize>()
     })
     .expect("frame");
     n + m

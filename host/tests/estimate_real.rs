@@ -82,7 +82,7 @@ fn features(img: &GrayImage, index: u64, keep: &dyn Fn(f32, f32) -> bool) -> Fea
         &config,
         img.as_raw(),
         &mut |p| points.extend_from_slice(p),
-        &mut |s| sobel.extend_from_slice(s),
+        &mut |s| sobel.extend(s.pixels()),
     )
     .expect("fabric fast path");
     assert_eq!(

@@ -8,7 +8,7 @@ use stereocal::driver::{Driver, DriverError, FrameOutcome, PairOutcome, Received
 use stereocal::frame::Gradients;
 use stereocal::link::{InProcessLink, Link};
 use stereocal_firmware::driver::fabric_config;
-use stereocal_firmware::fabric::{run_frame, Extremum, FastFrontEnd, SobelPixel};
+use stereocal_firmware::fabric::{run_frame, Extremum, FastFrontEnd, SobelPixel, SobelRun};
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hdl::FabricConfig;
 use stereocal_wire::{Camera, ErrorCode};
@@ -71,7 +71,7 @@ fn reference(config: &FabricConfig, image: &[u8]) -> (Vec<Extremum>, Vec<SobelPi
         &fabric_config(config),
         image,
         &mut |p: &[Extremum]| points.extend_from_slice(p),
-        &mut |s: &[SobelPixel]| sobel.extend_from_slice(s),
+        &mut |s: SobelRun<'_>| sobel.extend(s.pixels()),
     )
     .expect("reference run");
     (points, sobel)

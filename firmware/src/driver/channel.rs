@@ -13,7 +13,7 @@ use crate::driver::patch::{PatchQueue, PendingPatch, HALF};
 use crate::driver::point_batch::{wire_point, PointBatch};
 use crate::driver::sink::{ByteSink, PacketWriter};
 use crate::driver::sobel_ring::{Completed, SobelRing};
-use crate::fabric::{Config, Extremum, FrameError, FrontEnd, Overflow, SobelPixel as FabricSobel};
+use crate::fabric::{Config, Extremum, FrameError, FrontEnd, Overflow, SobelRun};
 
 /// What a channel can send, as announced in its `Hello`.
 pub const CHANNEL_CAPABILITIES: Capabilities = Capabilities(
@@ -324,9 +324,9 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         // clearing the FIFOs.
         let mut result = Ok(());
         let output = &mut self.output;
-        self.fabric.drain_sobel(&mut |pixels| {
+        self.fabric.drain_sobel(&mut |run| {
             if result.is_ok() {
-                result = output.on_sobel(pixels, out);
+                result = output.on_sobel(run, out);
             }
         });
         result
@@ -381,22 +381,22 @@ impl<const W0: usize> FrameOutput<W0> {
         }
     }
 
-    /// Stores consecutive pixels of the Sobel stream, sending what each row they complete
-    /// makes ready before storing the pixels after it.
+    /// Stores a run of the Sobel stream, sending what each row it completes makes ready
+    /// before storing the pixels after it.
     fn on_sobel<S: ByteSink>(
         &mut self,
-        mut pixels: &[FabricSobel],
+        mut run: SobelRun<'_>,
         out: &mut PacketWriter<S>,
     ) -> Result<(), DriverError> {
-        while !pixels.is_empty() {
+        while !run.is_empty() {
             let (taken, completed) = self
                 .ring
-                .push_run(pixels)
+                .push_run(&run)
                 .map_err(DriverError::SobelOutOfOrder)?;
             if let Some(completed) = completed {
                 self.rows_completed(completed, out)?;
             }
-            pixels = pixels.get(taken..).unwrap_or_default();
+            run = run.split_at(taken).1;
         }
         Ok(())
     }

@@ -7,7 +7,7 @@
 
 use crate::fabric::{
     Config, ConfigError, Extremum, FastFrontEnd, FrameError, FrontEnd, Overflow, RegisterFrontEnd,
-    SobelPixel,
+    SobelPixel, SobelRun,
 };
 
 /// Which implementation of the fabric runs the frames.
@@ -105,7 +105,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.front_end().drain_points(sink)
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.front_end().drain_sobel(sink)
     }
 }

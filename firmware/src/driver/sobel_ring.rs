@@ -16,7 +16,7 @@ use stereocal_wire::{SobelPixel, PATCH_PIXELS, PATCH_SIZE};
 
 use crate::fabric::config::MAX_OCTAVES;
 use crate::fabric::geometry::octave_dims;
-use crate::fabric::SobelPixel as FabricSobel;
+use crate::fabric::{SobelPixel as FabricSobel, SobelRun};
 
 /// Complete rows kept per octave.
 pub const RING_ROWS: usize = 32;
@@ -202,25 +202,23 @@ impl<const W0: usize> SobelRing<W0> {
         }))
     }
 
-    /// Stores the leading pixels of `pixels` (at least one, when it is not empty) and reports
+    /// Stores the leading pixels of `run` (at least one, when it is not empty) and reports
     /// how many it took and the rows they completed; exactly as [`Self::push`] on each of them,
     /// one at a time, would.
     ///
     /// The first pixel goes through [`Self::push`]. If it completed no row, it opened (or
-    /// continued) its row, so the pixels after it that continue that row (same octave and row,
-    /// columns one apart, ending at the last column at most) cannot fail and can only complete
-    /// their row with its last column: that run is found in one pass and copied as a block.
-    /// Anything else (a row's first pixel, a gap left by a dropped pixel, another octave) ends
-    /// the run and goes through [`Self::push`] on the next call, so its errors and completions
-    /// are reported as they would be pixel by pixel, and in the same order.
+    /// continued) its row, so the pixels after it, up to the row's last column, cannot fail
+    /// and can only complete the row with its last column: they are copied as a block. Pixels
+    /// past the row's end go through [`Self::push`] on the next call, so their error is
+    /// reported as it would be pixel by pixel.
     pub fn push_run(
         &mut self,
-        pixels: &[FabricSobel],
+        run: &SobelRun<'_>,
     ) -> Result<(usize, Option<Completed>), OutOfOrder> {
-        let Some((first, rest)) = pixels.split_first() else {
+        let Some(first) = run.pixels().next() else {
             return Ok((0, None));
         };
-        if let Some(completed) = self.push(first)? {
+        if let Some(completed) = self.push(&first)? {
             return Ok((1, Some(completed)));
         }
         let Some(rows) = self.octaves.get_mut(usize::from(first.octave)) else {
@@ -228,31 +226,26 @@ impl<const W0: usize> SobelRing<W0> {
         };
         // `push` accepted `first` without completing its row: `first.x + 1 < rows.width`.
         let room = usize::from(rows.width.saturating_sub(first.x + 1));
-        let candidates = rest.get(..room.min(rest.len())).unwrap_or_default();
-        let continues =
-            |(p, x): (&FabricSobel, u16)| p.octave == first.octave && p.y == first.y && p.x == x;
-        let n = candidates
-            .iter()
-            .zip(first.x + 1..)
-            .position(|c| !continues(c))
-            .unwrap_or(candidates.len());
-        let run = candidates.get(..n).unwrap_or_default();
+        let rest = run.split_at(1).1.split_at(room).0;
         let start = rows.slot(first.y).start + usize::from(first.x) + 1;
         let Some(cells) = self
             .store
             .as_flattened_mut()
-            .get_mut(start..start + run.len())
+            .get_mut(start..start + rest.len())
         else {
             return Ok((1, None));
         };
-        for (cell, p) in cells.iter_mut().zip(run) {
+        for (cell, (&magnitude, &orientation)) in cells
+            .iter_mut()
+            .zip(rest.magnitude.iter().zip(rest.orientation))
+        {
             *cell = SobelPixel {
-                magnitude: p.magnitude,
-                orientation: p.orientation,
+                magnitude,
+                orientation,
             };
         }
-        // `n < rows.width`, a `u16`.
-        let added = n as u16;
+        // `rest.len() < rows.width`, a `u16`.
+        let added = rest.len() as u16;
         let filled = rows.filled(first.y);
         *filled = filled.saturating_add(added);
         let completed = (first.x + added + 1 == rows.width).then(|| {
@@ -263,7 +256,7 @@ impl<const W0: usize> SobelRing<W0> {
                 rows: first.y..first.y + 1,
             }
         });
-        Ok((1 + run.len(), completed))
+        Ok((1 + rest.len(), completed))
     }
 
     /// Completes each octave's open row at the end of a frame.

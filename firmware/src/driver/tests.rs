@@ -17,8 +17,10 @@ use stereocal_wire::{
 use super::*;
 use crate::fabric::geometry::octave_dims;
 use crate::fabric::refine::Offset;
+use crate::fabric::sobel_fifo::SobelFifo;
 use crate::fabric::{
     Config, ConfigError, Extremum, FrameError, FrontEnd, Overflow, SobelPixel as FabricSobel,
+    SobelRun,
 };
 
 /// A sink that keeps every byte.
@@ -246,10 +248,10 @@ impl FrontEnd for Scripted {
         self.point_fifo.clear();
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[FabricSobel])) {
-        let (a, b) = self.sobel_fifo.as_slices();
-        sink(a);
-        sink(b);
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        self.sobel_fifo
+            .iter()
+            .for_each(|p| sink(SobelRun::single(p)));
         self.sobel_fifo.clear();
     }
 }
@@ -749,7 +751,7 @@ fn a_fabric_emitting_out_of_order_is_an_error() {
         fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
             self.0.drain_points(sink)
         }
-        fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[FabricSobel])) {
+        fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
             self.0.drain_sobel(sink)
         }
     }
@@ -1036,7 +1038,7 @@ fn register_level_model_sends_the_same_records_as_the_fast_path() {
     assert_eq!(results[0], results[1]);
 }
 
-/// A front end that hands its Sobel FIFO over one pixel per slice: the driver then stores
+/// A front end that hands its Sobel FIFO over in runs of one pixel: the driver then stores
 /// every pixel on its own, as the per-pixel path did before runs were copied as blocks.
 struct OnePixelAtATime<F>(F);
 
@@ -1065,9 +1067,14 @@ impl<F: FrontEnd> FrontEnd for OnePixelAtATime<F> {
     fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
         self.0.drain_points(sink)
     }
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[FabricSobel])) {
-        self.0
-            .drain_sobel(&mut |pixels| pixels.chunks(1).for_each(&mut *sink))
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        self.0.drain_sobel(&mut |mut run| {
+            while !run.is_empty() {
+                let (pixel, rest) = run.split_at(1);
+                sink(pixel);
+                run = rest;
+            }
+        })
     }
 }
 
@@ -1157,23 +1164,50 @@ fn push_run_reports_what_pixel_by_pixel_pushes_report() {
         }
     }
 
-    // In runs, going on after an error as the per-pixel loop did.
+    // In runs, as the Sobel FIFO groups the stream, going on after an error as the per-pixel
+    // loop did.
+    let mut fifo: SobelFifo<64, 2> = SobelFifo::new();
+    for p in &stream {
+        fifo.push(*p).expect("the stream fits");
+    }
+    let mut queued = Vec::new();
+    fifo.drain(&mut |run| {
+        queued.push((
+            run.octave,
+            run.y,
+            run.x,
+            run.magnitude.to_vec(),
+            run.orientation.to_vec(),
+        ))
+    });
+    assert!(queued.len() < stream.len(), "some pixels form runs");
     let mut runs = sobel_ring::SobelRing::<20>::new();
     runs.start(20, 12, 2);
     let mut got = Vec::new();
     let mut next = 0;
-    while next < stream.len() {
-        match runs.push_run(&stream[next..]) {
-            Ok((taken, completed)) => {
-                assert!(taken >= 1);
-                next += taken;
-                if let Some(c) = completed {
-                    got.push((next - 1, Ok(c)));
+    for (octave, y, x, magnitude, orientation) in &queued {
+        let mut run = SobelRun {
+            octave: *octave,
+            y: *y,
+            x: *x,
+            magnitude,
+            orientation,
+        };
+        while !run.is_empty() {
+            match runs.push_run(&run) {
+                Ok((taken, completed)) => {
+                    assert!(taken >= 1);
+                    next += taken;
+                    run = run.split_at(taken).1;
+                    if let Some(c) = completed {
+                        got.push((next - 1, Ok(c)));
+                    }
                 }
-            }
-            Err(e) => {
-                got.push((next, Err(e)));
-                next += 1;
+                Err(e) => {
+                    got.push((next, Err(e)));
+                    next += 1;
+                    run = run.split_at(1).1;
+                }
             }
         }
     }

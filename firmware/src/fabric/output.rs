@@ -18,6 +18,7 @@
 use crate::fabric::config::{Config, ConfigError};
 use crate::fabric::fifo::LineFifo;
 use crate::fabric::refine::Offset;
+use crate::fabric::sobel_fifo::{SobelFifo, SobelRun};
 
 /// A refined DoG extremum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,7 +84,7 @@ pub const POINT_FIFO_CAPACITY: usize = 512;
 #[derive(Clone, Debug)]
 pub struct OutputFifos<const W0: usize> {
     points: LineFifo<Extremum, 64, 8>,
-    sobel: LineFifo<SobelPixel, W0, 3>,
+    sobel: SobelFifo<W0, 3>,
     overflow: Overflow,
 }
 
@@ -98,13 +99,7 @@ impl<const W0: usize> OutputFifos<W0> {
     pub const fn new() -> Self {
         Self {
             points: LineFifo::new(Extremum::ZERO),
-            sobel: LineFifo::new(SobelPixel {
-                octave: 0,
-                orientation: 0,
-                magnitude: 0,
-                x: 0,
-                y: 0,
-            }),
+            sobel: SobelFifo::new(),
             overflow: Overflow {
                 points: 0,
                 sobel: 0,
@@ -139,16 +134,7 @@ impl<const W0: usize> OutputFifos<W0> {
     #[inline]
     pub fn push_sobel_row(&mut self, octave: u8, y: u16, magnitude: &[u8], orientation: &[u8]) {
         let n = magnitude.len().min(orientation.len());
-        let pixels = magnitude.iter().zip(orientation).enumerate();
-        let fit = self
-            .sobel
-            .extend(pixels.map(|(i, (&magnitude, &orientation))| SobelPixel {
-                octave,
-                orientation,
-                magnitude,
-                x: i as u16,
-                y,
-            }));
+        let fit = self.sobel.push_row(octave, y, magnitude, orientation);
         self.overflow.sobel = self.overflow.sobel.saturating_add((n - fit) as u32);
     }
 
@@ -157,9 +143,9 @@ impl<const W0: usize> OutputFifos<W0> {
         self.points.drain_slices(sink);
     }
 
-    /// Hands all queued Sobel pixels to `sink` (at most two slices) and empties the FIFO.
-    pub fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
-        self.sobel.drain_slices(sink);
+    /// Hands all queued Sobel pixels to `sink` in row runs and empties the FIFO.
+    pub fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        self.sobel.drain(sink);
     }
 
     /// Oldest point.
@@ -234,19 +220,20 @@ pub trait FrontEnd {
     fn overflow(&self) -> Overflow;
     /// Hands every queued point to `sink`, oldest first, in at most two slices.
     fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum]));
-    /// Hands every queued Sobel pixel to `sink`, oldest first, in at most two slices.
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel]));
+    /// Hands every queued Sobel pixel to `sink`, oldest first, in runs of consecutive pixels
+    /// of one row.
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>));
 }
 
 /// Runs a whole `config.width x config.height` frame through `fe`, draining the FIFOs after
-/// every row into the two callbacks (slices of consecutive items, oldest first). Returns the
-/// overflow counters.
+/// every row into the two callbacks (slices of consecutive points and runs of Sobel pixels,
+/// oldest first). Returns the overflow counters.
 pub fn run_frame<F: FrontEnd + ?Sized>(
     fe: &mut F,
     config: &Config,
     image: &[u8],
     on_points: &mut dyn FnMut(&[Extremum]),
-    on_sobel: &mut dyn FnMut(&[SobelPixel]),
+    on_sobel: &mut dyn FnMut(SobelRun<'_>),
 ) -> Result<Overflow, FrameError> {
     let (w, h) = (config.width as usize, config.height as usize);
     if image.len() != w * h {

@@ -9,6 +9,7 @@ use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::octave::Octave;
 use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
 use crate::fabric::probe::ClockProbe;
+use crate::fabric::sobel_fifo::SobelRun;
 
 /// Register-level front end (see the module docs for the width parameters).
 #[derive(Clone, Debug)]
@@ -211,7 +212,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.fifos.drain_points(sink);
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.fifos.drain_sobel(sink);
     }
 }

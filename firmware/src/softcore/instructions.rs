@@ -142,7 +142,7 @@ mod counted {
     use crate::fabric::fast::{column_filter, cordic_row, dog_row, row_filter, sobel_row};
     use crate::fabric::taps::GAUSS_TAPS;
     use crate::fabric::{
-        Config, ConfigError, Extremum, FrameError, FrontEnd, Overflow, SobelPixel,
+        Config, ConfigError, Extremum, FrameError, FrontEnd, Overflow, SobelPixel, SobelRun,
     };
 
     /// Widest row [`measure_kernels`] takes: the fabric's octave-0 line length.
@@ -316,7 +316,7 @@ mod counted {
             self.inner.drain_points(sink)
         }
 
-        fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
+        fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
             self.inner.drain_sobel(sink)
         }
     }

@@ -21,7 +21,7 @@ pub fn run<F: FrontEnd + ?Sized>(fe: &mut F, cfg: &Config, img: &[u8]) -> FrameO
         cfg,
         img,
         &mut |p| points.extend_from_slice(p),
-        &mut |s| sobel.extend_from_slice(s),
+        &mut |s| sobel.extend(s.pixels()),
     )
     .expect("frame runs");
     points.sort_by_key(|p| p.octave);

@@ -4,6 +4,7 @@ use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::fast::octave::FastOctave;
 use crate::fabric::fast::probe::{NoProbe, Probe};
 use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
+use crate::fabric::sobel_fifo::SobelRun;
 use crate::fabric::taps::{Taps, GAUSS_TAPS, TAP_BITS};
 
 /// Fast front end with the same width parameters as
@@ -192,7 +193,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.fifos.drain_points(sink);
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(&[SobelPixel])) {
+    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.fifos.drain_sobel(sink);
     }
 }
