@@ -1,5 +1,5 @@
-//! COBS encoding and decoding inside one buffer, a word or a code byte at a time instead of a
-//! byte at a time.
+//! COBS encoding and decoding inside one buffer, by zero masks of whole chunks and by code
+//! bytes instead of a byte at a time.
 //!
 //! The output is byte for byte that of the `cobs` crate (the proptests below compare them),
 //! but the `cobs` crate's state machine spends a match and a bounds check on every byte, and
@@ -31,12 +31,14 @@ const FULL_CODE: u8 = FULL_BLOCK as u8 + 1;
 /// of the first code byte. Each `0x00` then becomes the code of the block after it, the
 /// distance to the next `0x00` (or to the end), and the slot in front the distance to the
 /// first: a forward scan that writes each code when it finds the zero that ends the block.
-/// The zeros are found a machine word at a time ([`zero_bytes`]) and taken lowest first, so the
-/// cost is per word and per zero, not per byte (`memchr` per block was a call per ~11 bytes on
-/// Sobel rows); an all-zero word, common in flat image regions, is one store of `0x01`s. The
-/// bytes are read and written through cells, so one pass over the words can write the codes
-/// behind it. A block longer than [`FULL_BLOCK`] needs inserted code bytes, which
-/// [`Blocks::insert_full`] makes room for.
+/// The scan takes [`CHUNK`] bytes at a time, builds their zero mask without a branch
+/// ([`zero_mask`]) and writes the codes of its zeros lowest first ([`Blocks::close_chunk`]),
+/// so few branches depend on the data. A scan a word at a time, with a branch on each word's
+/// zeros and a loop over them, took twice as long on Sobel rows, mostly in mispredicted
+/// branches: two thirds of their words hold no zero, the others one to eight. The bytes are
+/// read and written through cells, so one pass can write the codes behind it. A block longer
+/// than [`FULL_BLOCK`] needs inserted code bytes, which [`Blocks::insert_full`] makes room
+/// for.
 pub(crate) fn encode_in_place(buf: &mut [u8], src: usize, len: usize) -> Option<usize> {
     if src == 0 {
         return None;
@@ -51,29 +53,19 @@ pub(crate) fn encode_in_place(buf: &mut [u8], src: usize, len: usize) -> Option<
     };
     let mut from = 1;
     'scan: loop {
-        let mut words = cells.get(from..blocks.end)?.chunks_exact(WORD);
+        let mut chunks = cells.get(from..blocks.end)?.chunks_exact(CHUNK);
         let mut base = from;
-        for word in &mut words {
-            let zeros = zero_bytes(load(word));
-            if zeros != 0 {
-                if let Some(moved_to) = blocks.close_word(cells, base, zeros)? {
-                    from = moved_to;
-                    continue 'scan;
-                }
-            }
-            base += WORD;
-        }
-        // The last, partial word, padded with non-zero bytes.
-        let mut last = [0xff; WORD];
-        for (to, from) in last.iter_mut().zip(words.remainder()) {
-            *to = from.get();
-        }
-        let zeros = zero_bytes(usize::from_le_bytes(last));
-        if zeros != 0 {
-            if let Some(moved_to) = blocks.close_word(cells, base, zeros)? {
+        for chunk in &mut chunks {
+            if let Some(moved_to) = blocks.close_chunk(cells, base, zero_mask(chunk))? {
                 from = moved_to;
                 continue 'scan;
             }
+            base += CHUNK;
+        }
+        let zeros = tail_zero_mask(chunks.remainder());
+        if let Some(moved_to) = blocks.close_chunk(cells, base, zeros)? {
+            from = moved_to;
+            continue 'scan;
         }
         break;
     }
@@ -84,62 +76,85 @@ pub(crate) fn encode_in_place(buf: &mut [u8], src: usize, len: usize) -> Option<
     }
     let end = blocks.end;
     cells.get(blocks.slot)?.set((end - blocks.slot) as u8);
-    Some(end)
+    // The room left over from the first full block on: the bytes after the last one move down.
+    move_bytes(
+        cells,
+        blocks.head,
+        blocks.head - blocks.gap,
+        end - blocks.head,
+    )?;
+    Some(end - blocks.gap)
 }
 
 /// The state of [`encode_in_place`]. Positions are where the bytes are now; the encoding of a
 /// byte at `p` goes to `p - gap`.
 ///
 /// Until the first full block `gap` is 0 and nothing moves. There, the rest of the packet
-/// moves `E` bytes towards the end, `E` the code bytes its full blocks insert
-/// ([`extra_codes`]), and the scan starts again in the moved bytes. Each inserted code closes
-/// the gap by one: the stretch since the last one (codes written in place) moves down to
-/// where it belongs, once, and its last byte, now read, becomes the slot of the code after
-/// the full block. After the last full block `gap` is 0 again, so nothing after it moves.
+/// moves `E` bytes towards the end, `E` the most code bytes its full blocks can insert (one
+/// per [`FULL_BLOCK`] bytes, and no more than `buf` has room for), and the scan starts again in
+/// the moved bytes. Each inserted code closes the gap by one: the stretch since the last one
+/// (codes written in place) moves down to where it belongs, once, and its last byte, now read,
+/// becomes the slot of the code after the full block. The stretch after the last full block
+/// moves down by what is left of the gap at the end. (Counting `E` exactly took a scan of the
+/// rest of the packet, which cost more than the one move it saves.)
 struct Blocks {
     /// Where the current block's code byte goes (its final place is `slot - gap`).
     slot: usize,
     /// Start of the stretch not yet moved to its final place (its first byte is a code).
     head: usize,
-    /// Code bytes still to insert.
+    /// Room still open for inserted code bytes.
     gap: usize,
     /// End of the packet.
     end: usize,
 }
 
 impl Blocks {
-    /// Ends a block at each zero of the word at `base` (`zeros` its [`zero_bytes`] mask).
+    /// Ends a block at each zero of the chunk at `base` (`zeros` its [`zero_mask`]).
     /// `Some(Some(p))` when the first full block moved the rest of the packet: the scan goes on
     /// at `p`, just after the zero that made room for it.
+    ///
+    /// Only the chunk's first zero can be more than [`FULL_BLOCK`] bytes from the slot (the
+    /// others are less than [`CHUNK`] bytes from the zero before them), and only when the slot
+    /// is that far from the chunk's last byte, which a well-predicted branch rules out first.
+    /// The first [`UNROLLED`] zeros are taken without a branch: once the mask is empty, a step
+    /// writes a meaningless code into the slot and keeps it, which is harmless, as the slot's
+    /// code is written again when its block ends. Only the zeros after those loop.
     #[inline(always)]
-    fn close_word(
+    fn close_chunk(
         &mut self,
         cells: &[Cell<u8>],
         base: usize,
         zeros: usize,
     ) -> Option<Option<usize>> {
-        let mut slot = self.slot;
-        if zeros == HIGHS && base - slot <= FULL_BLOCK {
-            // A flat word: its first zero ends the block before, each of the others an
-            // empty block, so the word becomes `01 01 .. 01` and its last byte the slot.
-            cells.get(slot)?.set((base - slot) as u8);
-            for cell in cells.get(base..base + WORD - 1)? {
+        if zeros == usize::MAX && base - self.slot <= FULL_BLOCK {
+            // A flat chunk: its first zero ends the block before, each of the others an
+            // empty block, so the chunk becomes `01 01 .. 01` and its last byte the slot.
+            cells.get(self.slot)?.set((base - self.slot) as u8);
+            for cell in cells.get(base..base + CHUNK - 1)? {
                 cell.set(1);
             }
-            self.slot = base + WORD - 1;
+            self.slot = base + CHUNK - 1;
             return Some(None);
         }
-        let mut zeros = zeros;
-        while zeros != 0 {
-            let zero = base + (zeros.trailing_zeros() / 8) as usize;
-            zeros &= zeros - 1;
-            if zero - slot > FULL_BLOCK {
-                self.slot = slot;
-                if let Some(moved_to) = self.insert_full_at(cells, zero)? {
+        if base + (CHUNK - 1) - self.slot > FULL_BLOCK && zeros != 0 {
+            let first = base + zeros.trailing_zeros() as usize;
+            if first - self.slot > FULL_BLOCK {
+                if let Some(moved_to) = self.insert_full_at(cells, first)? {
                     return Some(Some(moved_to));
                 }
-                slot = self.slot;
             }
+        }
+        let mut slot = self.slot;
+        let mut zeros = zeros;
+        for () in [(); UNROLLED] {
+            let zero = base + zeros.trailing_zeros() as usize;
+            cells.get(slot)?.set((zero - slot) as u8);
+            slot = if zeros != 0 { zero } else { slot };
+            zeros &= zeros.wrapping_sub(1);
+        }
+        while zeros != 0 {
+            let zero = base + zeros.trailing_zeros() as usize;
+            zeros &= zeros - 1;
             cells.get(slot)?.set((zero - slot) as u8);
             slot = zero;
         }
@@ -147,7 +162,7 @@ impl Blocks {
         Some(None)
     }
 
-    /// [`close_word`](Self::close_word) at a `zero` too far from the slot: inserts the full
+    /// [`close_chunk`](Self::close_chunk) at a `zero` too far from the slot: inserts the full
     /// blocks and, when that moved the packet, ends the block at the moved zero and returns
     /// where the scan goes on.
     #[cold]
@@ -163,13 +178,13 @@ impl Blocks {
     }
 
     /// Inserts full blocks until `at` (a zero or the end of the packet) is at most `most`
-    /// bytes from the slot; the first ever moves the rest of the packet to make room for all
-    /// of them, and the move is returned.
+    /// bytes from the slot; the first ever (or the first once the gap is used up) moves the
+    /// rest of the packet to make room for them, and the move is returned.
     fn insert_full(&mut self, cells: &[Cell<u8>], at: usize, most: usize) -> Option<usize> {
         let mut moved = 0;
         if self.gap == 0 {
             let rest = self.slot + 1;
-            moved = extra_codes(cells.get(rest..self.end)?);
+            moved = ((self.end - rest) / FULL_BLOCK).min(cells.len() - self.end);
             move_bytes(cells, rest, rest + moved, self.end - rest)?;
             self.gap = moved;
             self.end += moved;
@@ -188,42 +203,13 @@ impl Blocks {
                 self.head - self.gap,
                 block_end - self.head,
             )?;
-            self.gap -= 1;
+            // No room left: `buf` is shorter than the encoding.
+            self.gap = self.gap.checked_sub(1)?;
             self.slot = block_end - 1;
             self.head = self.slot;
         }
         Some(moved)
     }
-}
-
-/// Code bytes the full blocks of `data` insert: a zero-free run of `r` bytes holds
-/// `r / FULL_BLOCK` full blocks, each followed by a code of its own (a block ended by a zero
-/// has the zero's place for the next code), except a full block at the very end, after which
-/// COBS drops the empty block. Only runs that span words can be that long, so each word with a
-/// zero only ends the run before its first zero and starts one after its last.
-fn extra_codes(data: &[Cell<u8>]) -> usize {
-    let mut extra = 0;
-    let mut run_start = 0;
-    let mut words = data.chunks_exact(WORD);
-    let mut base = 0;
-    for word in &mut words {
-        let zeros = zero_bytes(load(word));
-        if zeros != 0 {
-            let first = base + (zeros.trailing_zeros() / 8) as usize;
-            extra += (first - run_start) / FULL_BLOCK;
-            run_start = base + ((usize::BITS - 1 - zeros.leading_zeros()) / 8) as usize + 1;
-        }
-        base += WORD;
-    }
-    for byte in words.remainder() {
-        if byte.get() == 0 {
-            extra += (base - run_start) / FULL_BLOCK;
-            run_start = base + 1;
-        }
-        base += 1;
-    }
-    let run = base - run_start;
-    extra + run / FULL_BLOCK - usize::from(run != 0 && run % FULL_BLOCK == 0)
 }
 
 /// The little-endian word in `cells` (`WORD` of them), one load once optimised.
@@ -245,13 +231,62 @@ const HIGHS: usize = ONES << 7;
 /// `0x7F` in every byte of a word.
 const LOWS: usize = !HIGHS;
 
-/// `0x80` in each byte of `word` that is `0x00`, `0x00` in the others, exactly: adding
+/// `0x80` in each byte of `word` that is not `0x00`, `0x00` in the others, exactly: adding
 /// `0x7F` to the low seven bits of a byte sets its top bit unless they are all clear, and
 /// cannot carry into the next byte; OR-ing the byte's own top bit in leaves it clear only for
 /// `0x00`. (The shorter `(w - 0x01..01) & !w` borrows across bytes and can flag a `0x01`
 /// above a zero, fine for [`first_zero`] but not for finding every zero.)
-fn zero_bytes(word: usize) -> usize {
-    !(((word & LOWS) + LOWS) | word) & HIGHS
+fn nonzero_bytes(word: usize) -> usize {
+    (((word & LOWS) + LOWS) | word) & HIGHS
+}
+
+/// Bytes [`encode_in_place`] scans at a time: one bit each fills a `usize` (64 on the host,
+/// 32 on the soft-core, eight words either way).
+const CHUNK: usize = usize::BITS as usize;
+
+/// Zeros of a chunk [`Blocks::close_chunk`] takes without a branch. A mispredicted branch
+/// costs a host CPU more than a few steps that do nothing: three in four chunks of Sobel rows
+/// hold at most eight zeros (a chunk of zeros takes its own path), and 6 to 8 steps were
+/// fastest there, 12 or more slower. The soft-core pays per instruction, not per
+/// misprediction, so it only loops.
+const UNROLLED: usize = if cfg!(target_os = "none") { 0 } else { 8 };
+
+/// `1 << 7j` for each byte `j` of a word: times a [`nonzero_bytes`] mask, whose flag for
+/// byte `i` is bit `8i + 7`, it puts that flag at bit `7 * WORD + i` (when `i + j` is
+/// `WORD - 1`), in the top `WORD` bits. The other products land either above the word or
+/// below bit `8 * WORD - 8`, at distinct bits (no carries), so the top bits are exact.
+const GATHER: usize = {
+    let mut gather = 0;
+    let mut byte = 0;
+    while byte < WORD {
+        gather |= 1 << (7 * byte);
+        byte += 1;
+    }
+    gather
+};
+
+/// Bit `i` set when byte `i` of `chunk` ([`CHUNK`] bytes) is `0x00`, with no branch on the
+/// data: each word's [`nonzero_bytes`] flags, gathered into the top `WORD` bits by one
+/// multiply ([`GATHER`]), shift in from the top, and the mask of non-zero bytes is inverted
+/// once at the end. (Shifting each word's flags into place by its index instead let the
+/// compiler vectorise half the multiplies into slower SSE2 emulations of 64-bit products.)
+#[inline(always)]
+fn zero_mask(chunk: &[Cell<u8>]) -> usize {
+    let mut nonzero = 0;
+    for word in chunk.chunks_exact(WORD) {
+        let flags = nonzero_bytes(load(word)).wrapping_mul(GATHER) & !(usize::MAX >> WORD);
+        nonzero = (nonzero >> WORD) | flags;
+    }
+    !nonzero
+}
+
+/// [`zero_mask`] of a partial chunk, padded with non-zero bytes.
+fn tail_zero_mask(tail: &[Cell<u8>]) -> usize {
+    let mut chunk = [0xff; CHUNK];
+    for (to, from) in chunk.iter_mut().zip(tail) {
+        *to = from.get();
+    }
+    zero_mask(Cell::from_mut(&mut chunk[..]).as_slice_of_cells())
 }
 
 /// Index of the first `0x00` in `bytes`, or its length.
@@ -393,6 +428,20 @@ mod tests {
         ]
     }
 
+    /// Byte strings shaped around the encoder's chunks and full blocks: zero-free runs of
+    /// about one or two chunks, or one, two or three full blocks, all-zero stretches, and
+    /// single zeros, so zeros and run ends fall on every side of chunk boundaries.
+    fn chunk_bytes() -> impl Strategy<Value = Vec<u8>> {
+        let run = prop_oneof![
+            (0usize..=2 * CHUNK + 2).prop_map(|len| vec![0x37; len]),
+            prop_oneof![252usize..=256, 506usize..=510, 760usize..=764]
+                .prop_map(|len| vec![0xc1; len]),
+            (0usize..=2 * CHUNK + 2).prop_map(|len| vec![0; len]),
+            Just(vec![0]),
+        ];
+        proptest::collection::vec(run, 0..10).prop_map(|runs| runs.concat())
+    }
+
     /// Encodes with the packet one byte in (as `crate::encode` places it) or further, in a
     /// buffer just long enough for the longest encoding, or a little longer.
     fn encode(bytes: &[u8], src: usize, slack: usize) -> Vec<u8> {
@@ -414,6 +463,29 @@ mod tests {
             let mut reference = vec![0u8; cobs::max_encoding_length(bytes.len())];
             let reference_len = cobs::encode(&bytes, &mut reference);
             prop_assert_eq!(encode(&bytes, src, slack), &reference[..reference_len]);
+        }
+
+        #[test]
+        fn encode_matches_the_cobs_crate_around_chunks(
+            bytes in chunk_bytes(),
+            src in 1usize..4,
+        ) {
+            prop_assert_eq!(encode(&bytes, src, 0), reference(&bytes));
+        }
+
+        #[test]
+        fn a_buffer_shorter_than_the_encoding_is_refused(
+            bytes in prop_oneof![hard_bytes(), chunk_bytes()],
+            short in 1usize..4,
+        ) {
+            // Shorter, but still holding the packet behind the first code.
+            let encoded_len = reference(&bytes).len();
+            let short = short.min(encoded_len - (1 + bytes.len()));
+            if short > 0 {
+                let mut buf = vec![0xeeu8; encoded_len - short];
+                buf[1..1 + bytes.len()].copy_from_slice(&bytes);
+                prop_assert_eq!(encode_in_place(&mut buf, 1, bytes.len()), None);
+            }
         }
 
         #[test]
@@ -440,6 +512,41 @@ mod tests {
             let mut encoded = encode(&bytes, 1, 0);
             let range = decode_in_place(&mut encoded).expect("valid COBS");
             prop_assert_eq!(&encoded[range], &bytes[..]);
+        }
+    }
+
+    /// The `cobs` crate's encoding of `bytes`.
+    fn reference(bytes: &[u8]) -> Vec<u8> {
+        let mut encoded = vec![0u8; cobs::max_encoding_length(bytes.len())];
+        let len = cobs::encode(bytes, &mut encoded);
+        encoded.truncate(len);
+        encoded
+    }
+
+    #[test]
+    fn long_runs_match_the_cobs_crate_at_every_alignment() {
+        let leads: [fn(usize) -> Vec<u8>; 3] = [
+            |lead| vec![0x11; lead],
+            |lead| vec![0; lead],
+            |lead| (0..lead).map(|i| u8::from(i % 3 != 0)).collect(),
+        ];
+        let tails: [&[u8]; 5] = [&[], &[0], &[0, 0x22], &[0; 70], &[0x22; 10]];
+        for lead in leads {
+            for lead_len in 0..=2 * CHUNK + 1 {
+                for run in [1, 253, 254, 255, 508, 509, 762, 763] {
+                    for tail in tails {
+                        let mut bytes = lead(lead_len);
+                        bytes.push(0);
+                        bytes.extend(core::iter::repeat_n(0x5a, run));
+                        bytes.extend_from_slice(tail);
+                        assert_eq!(
+                            encode(&bytes, 1, 0),
+                            reference(&bytes),
+                            "lead {lead_len}, run {run}, tail {tail:?}"
+                        );
+                    }
+                }
+            }
         }
     }
 
