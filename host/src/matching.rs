@@ -275,7 +275,7 @@ mod tests {
         let (mut mag, mut ori) = (Vec::new(), Vec::new());
         for y in 0..height {
             for x in 0..width {
-                let h = ((x % 8) * 73856093 ^ (y % 8) * 19349663).wrapping_mul(2654435761);
+                let h = (((x % 8) * 73856093) ^ ((y % 8) * 19349663)).wrapping_mul(2654435761);
                 mag.push((h % 200) as u8 + 20);
                 ori.push(((h >> 8) % 64) as u8);
             }

@@ -319,7 +319,7 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         while let Some(point) = self.fabric.pop_point() {
             self.output.on_point(&point, out)?;
         }
-        // In bulk, so the ring can take runs of a row at once. A slice handed over after an
+        // In bulk, so the ring can take runs of a row at once. A run handed over after an
         // error is dropped unread: the frame is abandoned anyway, and the next one starts by
         // clearing the FIFOs.
         let mut result = Ok(());

@@ -82,7 +82,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
     // The driver pops points one at a time, as the soft-core reads the FIFO register: matched
     // here rather than through `front_end()`, so each pop is a direct call the compiler can
     // inline into the driver's loop instead of a virtual one. (It takes Sobel pixels in bulk
-    // through `drain_sobel`: one virtual call per slice.)
+    // through `drain_sobel`: one virtual call per row run.)
     fn pop_point(&mut self) -> Option<Extremum> {
         match self {
             Self::Fast(fe) => fe.pop_point(),

@@ -1,5 +1,6 @@
 //! Bounded FIFO over `LINES` line memories of `W` entries (capacity `LINES·W`): the alignment
-//! delays between scale images and the output FIFOs the soft-core drains. Pushing into a full
+//! delays between scale images and the point FIFO the soft-core drains (the Sobel FIFO holds
+//! row runs: `sobel_fifo.rs`). Pushing into a full
 //! FIFO hands the value back; the caller counts it (nothing is dropped silently).
 //!
 //! Every access goes through `get`/`split_at_mut_checked`: the ring indices are below the
@@ -59,37 +60,6 @@ impl<T: Copy, const W: usize, const LINES: usize> LineFifo<T, W, LINES> {
         }
         self.len += 1;
         Ok(())
-    }
-
-    /// Free entries.
-    pub fn free(&self) -> usize {
-        Self::CAPACITY - self.len
-    }
-
-    /// Appends the entries of `values` while there is room, writing the at most two
-    /// contiguous runs of the ring directly; returns how many were appended (the rest of
-    /// `values` is not consumed).
-    #[inline]
-    pub fn extend(&mut self, values: impl IntoIterator<Item = T>) -> usize {
-        let mut values = values.into_iter();
-        let mut start = self.head + self.len;
-        if start >= Self::CAPACITY {
-            start -= Self::CAPACITY;
-        }
-        let free = self.free();
-        let mem = self.mem.as_flattened_mut();
-        let (before, after) = mem.split_at_mut_checked(start).unwrap_or_default();
-        // The free entries: from the write position to the end, then from the start.
-        let mut written = 0;
-        for run in [after, before] {
-            for slot in run.iter_mut().take(free - written) {
-                let Some(v) = values.next() else { break };
-                *slot = v;
-                written += 1;
-            }
-        }
-        self.len += written;
-        written
     }
 
     /// Hands every entry, oldest first, to `sink` as at most two slices, and empties the FIFO.
