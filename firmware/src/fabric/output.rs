@@ -134,7 +134,14 @@ impl<const W0: usize> OutputFifos<W0> {
     #[inline]
     pub fn push_sobel_row(&mut self, octave: u8, y: u16, magnitude: &[u8], orientation: &[u8]) {
         let n = magnitude.len().min(orientation.len());
-        let fit = self.sobel.push_row(octave, y, magnitude, orientation);
+        let row = SobelRun {
+            octave,
+            y,
+            x: 0,
+            magnitude,
+            orientation,
+        };
+        let fit = self.sobel.push_run(row);
         self.overflow.sobel = self.overflow.sobel.saturating_add((n - fit) as u32);
     }
 

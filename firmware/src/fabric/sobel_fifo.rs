@@ -166,52 +166,40 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
 
     /// Enqueues one pixel; when full, hands it back.
     pub fn push(&mut self, p: SobelPixel) -> Result<(), SobelPixel> {
-        if self.len == Self::CAPACITY {
-            return Err(p);
+        if self.push_run(SobelRun::single(&p)) == 1 {
+            Ok(())
+        } else {
+            Err(p)
         }
-        let at = Self::wrap(self.head + self.len);
-        let cells = (
-            self.magnitude.as_flattened_mut().get_mut(at),
-            self.orientation.as_flattened_mut().get_mut(at),
-        );
-        let (Some(magnitude), Some(orientation)) = cells else {
-            return Err(p);
-        };
-        *magnitude = p.magnitude;
-        *orientation = p.orientation;
-        self.len += 1;
-        self.append(p.octave, p.y, p.x, 1, at);
-        Ok(())
     }
 
-    /// Enqueues pixels `0..` of row `y` of `octave`, as many as fit; returns how many did.
-    pub fn push_row(&mut self, octave: u8, y: u16, magnitude: &[u8], orientation: &[u8]) -> usize {
-        let n = magnitude.len().min(orientation.len());
-        let fit = n.min(Self::CAPACITY - self.len);
+    /// Enqueues the leading pixels of `run`, as many as fit; returns how many did.
+    pub fn push_run(&mut self, run: SobelRun<'_>) -> usize {
+        let fit = run.len().min(Self::CAPACITY - self.len);
         let at = Self::wrap(self.head + self.len);
         // Up to the end of the rings, then from their start.
-        let first = fit.min(Self::CAPACITY - at);
+        let (first, second) = run.split_at(fit).0.split_at(Self::CAPACITY - at);
         let mut written = 0;
-        for (at, count) in [(at, first), (0, fit - first)] {
-            if count == 0 {
+        for (at, part) in [(at, first), (0, second)] {
+            if part.is_empty() {
                 continue;
             }
-            let rows = (
-                magnitude.get(written..written + count),
-                orientation.get(written..written + count),
-            );
             let rings = (
-                self.magnitude.as_flattened_mut().get_mut(at..at + count),
-                self.orientation.as_flattened_mut().get_mut(at..at + count),
+                self.magnitude
+                    .as_flattened_mut()
+                    .get_mut(at..at + part.magnitude.len()),
+                self.orientation
+                    .as_flattened_mut()
+                    .get_mut(at..at + part.orientation.len()),
             );
-            let ((Some(m), Some(o)), (Some(rm), Some(ro))) = (rows, rings) else {
+            let (Some(magnitude), Some(orientation)) = rings else {
                 break;
             };
-            rm.copy_from_slice(m);
-            ro.copy_from_slice(o);
-            self.len += count;
-            self.append(octave, y, written as u16, count as u16, at);
-            written += count;
+            magnitude.copy_from_slice(part.magnitude);
+            orientation.copy_from_slice(part.orientation);
+            self.len += part.len();
+            self.append(part.octave, part.y, part.x, part.len() as u16, at);
+            written += part.len();
         }
         written
     }
@@ -311,10 +299,11 @@ mod tests {
     enum Step {
         /// One pixel.
         Push(SobelPixel),
-        /// Pixels `0..len` of a row, their values drawn from `seed`.
-        Row {
+        /// Pixels `x..x + len` of a row, their values drawn from `seed`.
+        Run {
             octave: u8,
             y: u16,
+            x: u16,
             len: usize,
             seed: u8,
         },
@@ -337,15 +326,15 @@ mod tests {
     fn step() -> impl Strategy<Value = Step> {
         prop_oneof![
             4 => pixel().prop_map(Step::Push),
-            2 => (0u8..4, 0u16..4, 0usize..40, any::<u8>())
-                .prop_map(|(octave, y, len, seed)| Step::Row { octave, y, len, seed }),
+            2 => (0u8..4, 0u16..4, 0u16..40, 0usize..40, any::<u8>())
+                .prop_map(|(octave, y, x, len, seed)| Step::Run { octave, y, x, len, seed }),
             2 => Just(Step::Pop),
             1 => Just(Step::Drain),
         ]
     }
 
     proptest! {
-        /// Pushes, rows, pops and drains give the pixels, drops and lengths of a plain FIFO
+        /// Pushes, runs, pops and drains give the pixels, drops and lengths of a plain FIFO
         /// of pixel records with the same capacity, whatever the wrapping; every run is
         /// consecutive pixels of one row and none is empty.
         #[test]
@@ -357,21 +346,19 @@ mod tests {
                     Step::Push(p) => {
                         prop_assert_eq!(runs.push(p).is_ok(), records.push(p).is_ok());
                     }
-                    Step::Row { octave, y, len, seed } => {
+                    Step::Run { octave, y, x, len, seed } => {
                         let magnitude: Vec<u8> =
                             (0..len).map(|i| seed.wrapping_add(i as u8)).collect();
                         let orientation: Vec<u8> = magnitude.iter().map(|m| m % 64).collect();
-                        let written = runs.push_row(octave, y, &magnitude, &orientation);
-                        let pixels = magnitude.iter().zip(&orientation).enumerate().map(
-                            |(x, (&magnitude, &orientation))| SobelPixel {
-                                octave,
-                                orientation,
-                                magnitude,
-                                x: x as u16,
-                                y,
-                            },
-                        );
-                        let fit = pixels.map(|p| records.push(p)).take_while(Result::is_ok).count();
+                        let run = SobelRun {
+                            octave,
+                            y,
+                            x,
+                            magnitude: &magnitude,
+                            orientation: &orientation,
+                        };
+                        let written = runs.push_run(run);
+                        let fit = run.pixels().map(|p| records.push(p)).take_while(Result::is_ok).count();
                         prop_assert_eq!(written, fit);
                     }
                     Step::Pop => prop_assert_eq!(runs.pop(), records.pop()),
