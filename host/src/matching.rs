@@ -203,17 +203,27 @@ mod tests {
     use crate::frame::{FeatureFrame, Gradients, SobelPlane};
     use proptest::prelude::*;
 
-    fn textured(width: u32, height: u32, dx: i32, dy: i32) -> SobelPlane {
+    /// A plane whose gradient at `(x, y)` is drawn from `hash(x, y)`.
+    fn hashed(width: u32, height: u32, hash: impl Fn(i32, i32) -> u32) -> SobelPlane {
         let mut mag = Vec::new();
         let mut ori = Vec::new();
         for y in 0..height as i32 {
             for x in 0..width as i32 {
-                let h = ((x - dx).wrapping_mul(73856093) ^ (y - dy).wrapping_mul(19349663)) as u32;
+                let h = hash(x, y);
                 mag.push((h % 200) as u8 + 20);
                 ori.push(((h >> 8) % 64) as u8);
             }
         }
         SobelPlane::new(0, width, height, mag, ori).unwrap()
+    }
+
+    /// A pseudo-random texture of pixel `(x, y)`.
+    fn texture_hash(x: i32, y: i32) -> u32 {
+        (x.wrapping_mul(73856093) ^ y.wrapping_mul(19349663)) as u32
+    }
+
+    fn textured(width: u32, height: u32, dx: i32, dy: i32) -> SobelPlane {
+        hashed(width, height, |x, y| texture_hash(x - dx, y - dy))
     }
 
     fn frame(plane: SobelPlane, pts: &[(f32, f32)]) -> FeatureFrame {
@@ -272,15 +282,7 @@ mod tests {
     /// A texture that repeats every 8 pixels: keypoints 8 pixels apart get equal descriptors,
     /// so equal distances, the ties the scan must break as one pass in index order would.
     fn periodic(width: u32, height: u32) -> SobelPlane {
-        let (mut mag, mut ori) = (Vec::new(), Vec::new());
-        for y in 0..height {
-            for x in 0..width {
-                let h = (((x % 8) * 73856093) ^ ((y % 8) * 19349663)).wrapping_mul(2654435761);
-                mag.push((h % 200) as u8 + 20);
-                ori.push(((h >> 8) % 64) as u8);
-            }
-        }
-        SobelPlane::new(0, width, height, mag, ori).unwrap()
+        hashed(width, height, |x, y| texture_hash(x % 8, y % 8))
     }
 
     proptest! {

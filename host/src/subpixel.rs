@@ -214,12 +214,8 @@ fn refine_in(
             *gyv = 0.5 * (f32::from(b) - f32::from(a));
         }
     }
-    let t_mean = lane_sums([&*t])[0] / n as f32;
+    let (t_mean, t_norm) = mean_and_norm(t, p0);
     t.iter_mut().for_each(|v| *v -= t_mean);
-    for (o, &v) in p0.iter_mut().zip(t.iter()) {
-        *o = v * v;
-    }
-    let t_norm = lane_sums([&*p0])[0].sqrt();
     for ((xx, xy), (yy, (&x, &y))) in p0
         .iter_mut()
         .zip(p1.iter_mut())
