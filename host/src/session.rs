@@ -163,6 +163,11 @@ pub struct Session<D: Device = Threaded> {
     /// (the firmware driver's channel), one per pair.
     next_frame_id: u32,
     in_flight: VecDeque<InFlight>,
+    /// A pair that came from a device with its own cameras before its session frame did
+    /// (the device skipped ids): it waits for [`Session::receive`] to reach it.
+    early: Option<PairOutcome>,
+    /// Capture time of the last pair filtered.
+    last_timestamp_us: Option<u64>,
     cost: SessionCost,
 }
 
@@ -204,6 +209,8 @@ impl<D: Device> Session<D> {
             filter: VergeFilter::new(config.kalman),
             next_frame_id: 0,
             in_flight: VecDeque::new(),
+            early: None,
+            last_timestamp_us: None,
             cost: SessionCost::default(),
         })
     }
@@ -297,12 +304,65 @@ impl<D: Device> Session<D> {
     /// Reads the pair back, estimates and filters it.
     fn finish(&mut self, pair: InFlight) -> Result<FrameRecord, SessionError> {
         let start = Instant::now();
-        let InFlight {
-            frame,
-            submitted,
-            timestamp_us,
-            truth_deg,
-        } = pair;
+        let outcome = if pair.submitted {
+            self.receive_pair(pair.frame)?
+        } else {
+            None
+        };
+        let record = self.conclude(pair.frame, outcome, pair.timestamp_us, pair.truth_deg)?;
+        self.cost.elapsed += start.elapsed();
+        Ok(record)
+    }
+
+    /// The record of the next pair from a device that captures with its own cameras
+    /// ([`OwnCameras`](crate::link::OwnCameras)): session frame `frame`, the device's next
+    /// frame id. The filter runs on the capture time the device stamped; a pair that arrived
+    /// damaged, or whose id the device skipped (its frames were lost on the link), is recorded
+    /// as dropped, its time unknown: the filter carries its state on to the next pair that
+    /// has one. Waiting longer than the device's answer timeout is an error, as is a closed
+    /// link: the caller decides whether that ends the stream.
+    pub fn receive(&mut self, frame: usize) -> Result<FrameRecord, SessionError> {
+        let expected = self.next_frame_id;
+        self.next_frame_id = expected.wrapping_add(1);
+        let timeout = self.driver.link().answer_timeout();
+        let outcome = loop {
+            let outcome = match self.early.take() {
+                Some(outcome) => outcome,
+                None => self.driver.next_pair(timeout)?,
+            };
+            let got = outcome.frame_id();
+            // Ids wrap: "older" is within half the id space behind. An older pair is the rest
+            // of one already recorded as dropped; a newer one waits for its own frame.
+            if got == expected {
+                self.cost.wire_bytes += outcome.wire_bytes();
+                break Some(outcome);
+            }
+            if expected.wrapping_sub(got) > u32::MAX / 2 {
+                self.early = Some(outcome);
+                break None;
+            }
+        };
+        let start = Instant::now();
+        let captured = match &outcome {
+            Some(PairOutcome::Pair {
+                left: FrameOutcome::Delivered(left),
+                right: FrameOutcome::Delivered(_),
+            }) => left.features.timestamp_us,
+            _ => self.last_timestamp_us.unwrap_or(0),
+        };
+        let record = self.conclude(frame, outcome, captured, None)?;
+        self.cost.elapsed += start.elapsed();
+        Ok(record)
+    }
+
+    /// Estimates and filters one pair's outcome (`None`: nothing arrived) into its record.
+    fn conclude(
+        &mut self,
+        frame: usize,
+        outcome: Option<PairOutcome>,
+        timestamp_us: u64,
+        truth_deg: Option<f64>,
+    ) -> Result<FrameRecord, SessionError> {
         let mut record = FrameRecord {
             frame,
             raw_verge_deg: None,
@@ -315,41 +375,38 @@ impl<D: Device> Session<D> {
             status: FrameStatus::Dropped,
             truth_deg,
         };
-        let measurement = if submitted {
-            match self.receive_pair(frame)? {
-                Some(PairOutcome::Pair {
-                    left: FrameOutcome::Delivered(left),
-                    right: FrameOutcome::Delivered(right),
-                }) => {
-                    record.status = FrameStatus::NoEstimate;
-                    let estimating = Instant::now();
-                    let estimate = self.estimator.estimate(&left.features, &right.features);
-                    self.cost.estimating += estimating.elapsed();
-                    match estimate {
-                        Ok(est) => {
-                            record.raw_verge_deg = Some(est.verge_deg);
-                            record.matches = est.matches;
-                            record.inliers = est.inliers;
-                            record.keypoints_per_octave = est.keypoints_per_octave;
-                            record.matches_per_octave = est.matches_per_octave;
-                            record.status = FrameStatus::Ok;
-                            Some(Measurement {
-                                verge_deg: est.verge_deg,
-                                sigma_deg: est.sigma_deg,
-                            })
-                        }
-                        Err(_) => None,
+        let measurement = match outcome {
+            Some(PairOutcome::Pair {
+                left: FrameOutcome::Delivered(left),
+                right: FrameOutcome::Delivered(right),
+            }) => {
+                record.status = FrameStatus::NoEstimate;
+                let estimating = Instant::now();
+                let estimate = self.estimator.estimate(&left.features, &right.features);
+                self.cost.estimating += estimating.elapsed();
+                match estimate {
+                    Ok(est) => {
+                        record.raw_verge_deg = Some(est.verge_deg);
+                        record.matches = est.matches;
+                        record.inliers = est.inliers;
+                        record.keypoints_per_octave = est.keypoints_per_octave;
+                        record.matches_per_octave = est.matches_per_octave;
+                        record.status = FrameStatus::Ok;
+                        Some(Measurement {
+                            verge_deg: est.verge_deg,
+                            sigma_deg: est.sigma_deg,
+                        })
                     }
+                    Err(_) => None,
                 }
-                Some(_) | None => None,
             }
-        } else {
-            None
+            Some(_) | None => None,
         };
         let filtered = self
             .filter
             .step(timestamp_us, measurement)
             .map_err(|source| SessionError::Time { frame, source })?;
+        self.last_timestamp_us = Some(timestamp_us);
         if record.status == FrameStatus::Ok {
             if let Some(f) = filtered {
                 record.filtered_verge_deg = Some(f.verge_deg);
@@ -357,7 +414,6 @@ impl<D: Device> Session<D> {
             }
         }
         self.cost.pairs += 1;
-        self.cost.elapsed += start.elapsed();
         Ok(record)
     }
 

@@ -3,6 +3,7 @@
 mod experiment;
 mod hil;
 mod inject;
+mod live;
 mod options;
 mod output;
 mod real;
@@ -31,6 +32,8 @@ enum Command {
     Synth(synthetic::SynthArgs),
     /// The `eval` run with the firmware ELF on the emulated soft-core (QEMU).
     Hil(hil::HilArgs),
+    /// Listen to a head that grabs its own frames (serial port, TCP or Unix socket).
+    Live(live::LiveArgs),
     /// Turn a real rectified pair into a sequence with an exactly injected verge per frame.
     Inject(inject::InjectArgs),
     /// Reproduce one of the thesis' experiments (or all) as CSV tables and PNG figures.
@@ -47,6 +50,7 @@ impl Cli {
             Command::Eval(a) => synthetic::eval(a),
             Command::Synth(a) => synthetic::synth(a),
             Command::Hil(a) => hil::hil(a),
+            Command::Live(a) => live::live(a),
             Command::Inject(a) => inject::inject(a),
             Command::Experiment(a) => experiment::experiment(a),
             Command::Reliability(a) => reliability::reliability(a),

@@ -21,7 +21,8 @@ use stereocal_firmware::driver::{
     ByteSink, Driver as Channel, DriverError as ChannelError, FabricModel, FrameSummary,
     PacketWriter,
 };
-use stereocal_hdl::RegisterBank;
+use stereocal_hdl::regs::control;
+use stereocal_hdl::{RegisterBank, RegisterBus};
 use stereocal_wire::{decode, Accumulator, Camera, FeedResult, PacketRepr, MAX_FRAME_LEN};
 
 use super::renumber::renumber_in_place;
@@ -213,6 +214,12 @@ impl InProcessLink {
     /// [`Device::take_sent`](super::Device::take_sent)).
     pub fn take_sent(&mut self, out: &mut Vec<u8>) {
         self.writer.sink_mut().take_into(out);
+    }
+
+    /// Whether the host has set CONTROL.ENABLE: a head with its own cameras (the firmware's
+    /// main loop, a board) starts grabbing then, so a stand-in for one waits for it.
+    pub fn enabled(&mut self) -> bool {
+        self.left.bus_mut().read_field(&control::ENABLE) != 0
     }
 
     /// Bytes the device sent that the host has not read yet.

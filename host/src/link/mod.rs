@@ -17,12 +17,14 @@
 //! | any link above, its received bytes damaged by seed | [`FaultLink`] | [`FaultLink::new`] |
 //! | the firmware ELF under `qemu-system-riscv32` | [`QemuDevice`](crate::hil::QemuDevice) | [`QemuDevice::start`](crate::hil::QemuDevice::start) |
 //!
-//! A link that also takes camera frames is a [`Device`]: what a session runs on.
+//! A link that also takes camera frames is a [`Device`]: what a session runs on. A head that
+//! grabs its own frames (a board, an emulator started by hand) is one through [`OwnCameras`].
 
 mod device;
 mod error;
 mod fault;
 mod in_process;
+mod own_cameras;
 mod recording;
 mod renumber;
 mod replay;
@@ -39,6 +41,7 @@ pub use device::Device;
 pub use error::LinkError;
 pub use fault::{BadRate, FaultConfig, FaultCounts, FaultLink};
 pub use in_process::InProcessLink;
+pub use own_cameras::OwnCameras;
 pub use recording::Recording;
 pub use replay::ReplayLink;
 pub use serial::SerialLink;

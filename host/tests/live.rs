@@ -1,0 +1,321 @@
+//! `stereocal live` against a head that grabs its own frames: the in-process firmware and
+//! fabric model behind a TCP socket, a Unix socket and a pseudo-terminal standing in for a
+//! board's serial port. The head waits for the host's enable, then streams the pairs of a
+//! rendered sequence and closes the link; `live` must estimate exactly what `run` estimates
+//! on the same images (the same bytes cross the wire), and a head that goes quiet must end in
+//! a timeout that names the link, with the pairs already received written out.
+
+use std::io::ErrorKind;
+use std::net::TcpListener;
+use std::path::Path;
+use std::process::{Command, Output};
+use std::thread;
+use std::time::Duration;
+
+use stereocal::link::{Device, InProcessLink, Link, TimedStream};
+
+const BIN: &str = env!("CARGO_BIN_EXE_stereocal");
+const FRAMES: usize = 4;
+/// The sequence's frame period at `stereocal run`'s default 30 fps.
+const PERIOD_US: f64 = 1e6 / 30.0;
+
+fn stereocal(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .output()
+        .expect("stereocal runs")
+}
+
+/// Renders the road sequence into `dir` (left/, right/, calib.toml).
+fn synth(dir: &Path) -> (u32, u32) {
+    let out = stereocal(&[
+        "synth",
+        "--scene",
+        "road",
+        "--frames",
+        &FRAMES.to_string(),
+        "--seed",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    image::open(dir.join("left").join(first_file(&dir.join("left"))))
+        .expect("rendered image")
+        .to_luma8()
+        .dimensions()
+}
+
+fn first_file(dir: &Path) -> String {
+    let mut names: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    names.remove(0)
+}
+
+fn sorted_images(dir: &Path) -> Vec<Vec<u8>> {
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    paths.sort();
+    paths
+        .iter()
+        .map(|p| image::open(p).unwrap().to_luma8().into_raw())
+        .collect()
+}
+
+/// The head: answers the host through the in-process device until it is enabled, then
+/// grabs the first `pairs` pairs of `dir` as its cameras would, sends their packets and, when
+/// `close` is set, closes the link (a quiet head keeps it open until the host leaves).
+fn head(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool) {
+    let left = sorted_images(&dir.join("left"));
+    let right = sorted_images(&dir.join("right"));
+    let mut device = InProcessLink::new().unwrap();
+    stream
+        .set_receive_timeout(Duration::from_millis(10))
+        .unwrap();
+    let mut buf = [0u8; 4096];
+    let mut out = Vec::new();
+    let mut grabbed = false;
+    loop {
+        match stream.read(&mut buf) {
+            Ok(0) => return,
+            Ok(n) => device.send(&buf[..n]).unwrap(),
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(_) => return,
+        }
+        if device.enabled() && !grabbed {
+            grabbed = true;
+            for (i, (l, r)) in left.iter().zip(&right).take(pairs).enumerate() {
+                device
+                    .submit_pair(l, r, (i as f64 * PERIOD_US).round() as u64)
+                    .unwrap();
+            }
+        }
+        out.clear();
+        Device::take_sent(&mut device, &mut out).unwrap();
+        if stream.write_all(&out).is_err() {
+            return;
+        }
+        if grabbed && close {
+            return;
+        }
+    }
+}
+
+fn raw_verges(csv: &Path) -> Vec<String> {
+    std::fs::read_to_string(csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').take(2).collect::<Vec<_>>().join(","))
+        .collect()
+}
+
+/// `live` on `link_args` while `serve` runs the head, then the same frames through `run`.
+fn live_equals_run(link_args: &[&str], serve: impl FnOnce(&Path) + Send) {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("seq");
+    let (w, h) = synth(&seq);
+    let calib = seq.join("calib.toml");
+    let live_out = dir.path().join("live");
+    let run_out = dir.path().join("run");
+    let live = thread::scope(|scope| {
+        scope.spawn(|| serve(&seq));
+        let mut args = vec!["live"];
+        args.extend_from_slice(link_args);
+        let (w, h) = (w.to_string(), h.to_string());
+        args.extend([
+            "--calib",
+            calib.to_str().unwrap(),
+            "--width",
+            &w,
+            "--height",
+            &h,
+            "--out",
+            live_out.to_str().unwrap(),
+            "--json",
+        ]);
+        stereocal(&args)
+    });
+    assert!(
+        live.status.success(),
+        "{}",
+        String::from_utf8_lossy(&live.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&live.stdout).unwrap();
+    assert_eq!(summary["frames"], FRAMES);
+    assert_eq!(summary["estimated_frames"], FRAMES);
+    let run = stereocal(&[
+        "run",
+        "--left",
+        seq.join("left").to_str().unwrap(),
+        "--right",
+        seq.join("right").to_str().unwrap(),
+        "--calib",
+        calib.to_str().unwrap(),
+        "--out",
+        run_out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let (live, run) = (
+        raw_verges(&live_out.join("verge.csv")),
+        raw_verges(&run_out.join("verge.csv")),
+    );
+    assert_eq!(live.len(), FRAMES);
+    assert_eq!(live, run, "live and run estimate the same bytes alike");
+    assert!(live_out.join("verge.png").is_file());
+}
+
+#[test]
+fn live_over_tcp_estimates_what_run_does() {
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = listener.local_addr().unwrap().to_string();
+    live_equals_run(&["--tcp", &addr], |seq| {
+        let (stream, _) = listener.accept().unwrap();
+        head(stream, seq, FRAMES, true);
+    });
+}
+
+#[cfg(unix)]
+#[test]
+fn live_over_a_unix_socket_estimates_what_run_does() {
+    use std::os::unix::net::UnixListener;
+    let sock_dir = tempfile::tempdir().unwrap();
+    let path = sock_dir.path().join("head.sock");
+    let listener = UnixListener::bind(&path).unwrap();
+    live_equals_run(&["--unix", path.to_str().unwrap()], |seq| {
+        let (stream, _) = listener.accept().unwrap();
+        head(stream, seq, FRAMES, true);
+    });
+}
+
+#[cfg(unix)]
+#[test]
+fn live_over_a_serial_port_estimates_what_run_does() {
+    use serialport::{SerialPort, TTYPort};
+    let (master, slave) = TTYPort::pair().expect("pseudo-terminal pair");
+    let name = slave.name().expect("pty name");
+    // A UART never ends its stream: the run is bounded by --frames.
+    let frames = FRAMES.to_string();
+    live_equals_run(
+        &["--serial", &name, "--baud", "115200", "--frames", &frames],
+        move |seq| {
+            // The host opens the slave by name; this end stays open until the head is done.
+            let _slave = slave;
+            head(Box::new(master) as Box<dyn SerialPort>, seq, FRAMES, true);
+        },
+    );
+}
+
+#[test]
+fn a_quiet_head_times_out_naming_the_link_and_keeps_what_arrived() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("seq");
+    let (w, h) = synth(&seq);
+    let out_dir = dir.path().join("live");
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = listener.local_addr().unwrap().to_string();
+    let live = thread::scope(|scope| {
+        scope.spawn(|| {
+            let (stream, _) = listener.accept().unwrap();
+            head(stream, &seq, 2, false);
+        });
+        stereocal(&[
+            "live",
+            "--tcp",
+            &addr,
+            "--calib",
+            seq.join("calib.toml").to_str().unwrap(),
+            "--width",
+            &w.to_string(),
+            "--height",
+            &h.to_string(),
+            "--frames",
+            "3",
+            "--timeout-ms",
+            "500",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ])
+    });
+    assert!(!live.status.success());
+    let stderr = String::from_utf8_lossy(&live.stderr);
+    assert!(
+        stderr.contains(&format!("frame 2 on tcp {addr}")) && stderr.contains("timed out"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("stopped after 2 frame pairs"), "{stderr}");
+    assert_eq!(raw_verges(&out_dir.join("verge.csv")).len(), 2);
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_ends_the_run_and_writes_what_arrived() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("seq");
+    let (w, h) = synth(&seq);
+    let out_dir = dir.path().join("live");
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = listener.local_addr().unwrap().to_string();
+    let live = thread::scope(|scope| {
+        scope.spawn(|| {
+            let (stream, _) = listener.accept().unwrap();
+            head(stream, &seq, 2, false);
+        });
+        let child = Command::new(BIN)
+            .args([
+                "live",
+                "--tcp",
+                &addr,
+                "--calib",
+                seq.join("calib.toml").to_str().unwrap(),
+                "--width",
+                &w.to_string(),
+                "--height",
+                &h.to_string(),
+                "--timeout-ms",
+                "3000",
+                "--out",
+                out_dir.to_str().unwrap(),
+            ])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Two pairs take well under this; the head then stays quiet.
+        thread::sleep(Duration::from_secs(2));
+        let kill = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(kill.success());
+        child.wait_with_output().unwrap()
+    });
+    assert!(
+        live.status.success(),
+        "{}",
+        String::from_utf8_lossy(&live.stderr)
+    );
+    assert_eq!(raw_verges(&out_dir.join("verge.csv")).len(), 2);
+}
+
+#[test]
+fn live_needs_exactly_one_link() {
+    let out = stereocal(&[
+        "live", "--calib", "c.toml", "--width", "64", "--height", "64",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--serial"));
+}
