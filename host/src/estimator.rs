@@ -7,6 +7,7 @@
 //! starting point and a Cauchy-weighted Gauss-Newton refinement over all matches gives the
 //! answer and its uncertainty.
 
+use nalgebra::Matrix3;
 use rayon::prelude::*;
 use stereocal_hdl::regs::MAX_OCTAVES;
 
@@ -250,17 +251,40 @@ impl VergeEstimator {
             })
             .collect();
         let focal = 0.5 * (self.calib.left.focal_px() + self.calib.right.focal_px());
-        let init = match self.config.ransac {
+        // The thesis' solve (4.5): e1..e4 by SVD, rank 2 enforced, the 180° ambiguity
+        // resolved, over RANSAC's consensus set (or every match without RANSAC), each match
+        // weighted as the refinement weighs it. Its angles start the refinement; should the
+        // set be degenerate, RANSAC's own hypothesis (or the parallel head) does.
+        let (consensus, fallback) = match self.config.ransac {
             Some(cfg) => {
                 let cfg = RansacConfig {
                     threshold: self.config.ransac_threshold_px / focal,
                     ..cfg
                 };
-                ransac(&corr, &cfg)?.angles
+                let found = ransac(&corr, &cfg)?;
+                (found.inliers, found.angles)
             }
-            None => VergeAngles::new(0.0, 0.0),
+            None => (vec![true; corr.len()], VergeAngles::new(0.0, 0.0)),
         };
-        let cfit = constrained::refine(&corr, init, &self.config.refine)?;
+        let linear_weights: Vec<f64> = corr
+            .iter()
+            .zip(&consensus)
+            .map(|(c, &inlier)| if inlier { c.weight } else { 0.0 })
+            .collect();
+        let linear = constrained::linear_weighted(&corr, &linear_weights).unwrap_or(fallback);
+        // Without RANSAC the linear solve saw the outliers too, so the parallel head is a
+        // second start; the lower robust cost wins.
+        let starts: &[VergeAngles] = match self.config.ransac {
+            Some(_) => &[linear],
+            None => &[linear, fallback],
+        };
+        let cfit = lowest_cost(
+            starts
+                .iter()
+                .map(|s| constrained::refine(&corr, *s, &self.config.refine)),
+            &corr,
+            |f| (f.residual_sigma, f.angles.essential()),
+        )?;
         let mut est = FrameEstimate {
             verge_deg: cfit.angles.verge_deg(),
             sigma_deg: cfit.verge_sigma.to_degrees(),
@@ -281,20 +305,13 @@ impl VergeEstimator {
                 RelativePose::from_verge(cfit.angles),
                 RelativePose::from_verge(VergeAngles::new(0.0, 0.0)),
             ];
-            let fits: Vec<_> = starts
-                .iter()
-                .filter_map(|s| general::refine(&corr, *s, &self.config.refine).ok())
-                .collect();
-            let scale = fits
-                .iter()
-                .map(|f| f.residual_sigma)
-                .fold(f64::INFINITY, f64::min);
-            let gfit = fits
-                .into_iter()
-                .map(|f| (cauchy_cost(&f.pose.essential(), &corr, scale), f))
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, f)| f)
-                .ok_or(EssentialError::Degenerate)?;
+            let gfit = lowest_cost(
+                starts
+                    .iter()
+                    .map(|s| general::refine(&corr, *s, &self.config.refine)),
+                &corr,
+                |f| (f.residual_sigma, f.pose.essential()),
+            )?;
             est.verge_deg = gfit.pose.verge().to_degrees();
             est.sigma_deg = gfit.verge_sigma.to_degrees();
             est.angles = None;
@@ -310,6 +327,30 @@ impl VergeEstimator {
         }
         Ok(est)
     }
+}
+
+/// Of refinements from several starts, the one with the lowest robust (Cauchy) cost, every
+/// cost taken at the smallest residual scale among them so that they share one yardstick;
+/// `scale_and_e` gives a fit's residual σ and essential matrix. When every start failed, the
+/// first failure.
+fn lowest_cost<F>(
+    fits: impl Iterator<Item = Result<F, EssentialError>>,
+    corr: &[Correspondence],
+    scale_and_e: impl Fn(&F) -> (f64, Matrix3<f64>),
+) -> Result<F, EssentialError> {
+    let mut first_err = None;
+    let fits: Vec<F> = fits
+        .filter_map(|f| f.map_err(|e| *first_err.get_or_insert(e)).ok())
+        .collect();
+    let scale = fits
+        .iter()
+        .map(|f| scale_and_e(f).0)
+        .fold(f64::INFINITY, f64::min);
+    fits.into_iter()
+        .map(|f| (cauchy_cost(&scale_and_e(&f).1, corr, scale), f))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, f)| f)
+        .ok_or(first_err.unwrap_or(EssentialError::Degenerate))
 }
 
 /// A refined match as the estimator takes it: the pixel pair and its vertical 1-σ.
@@ -488,5 +529,61 @@ mod tests {
                 .estimate_from_pixels(&pairs[..5]),
             Err(EstimateError::TooFewMatches { got: 5, need: 12 })
         ));
+    }
+
+    /// The refinement starts from the linear SVD solve (thesis 4.5): on exact matches of a
+    /// strongly verged head one Gauss-Newton step leaves that start where it is, on the
+    /// truth, with or without RANSAC; one step from the parallel head would not get there.
+    #[test]
+    fn refinement_starts_from_the_linear_svd_solve() {
+        let cam = CameraIntrinsics::pinhole(700.0, 700.0, 320.0, 240.0);
+        let calib = Calibration {
+            baseline_m: 0.3,
+            left: cam,
+            right: cam,
+        };
+        let truth = VergeAngles::new(9f64.to_radians(), -6f64.to_radians());
+        let m = synthetic(
+            rot_y(truth.alpha_l),
+            rot_y(truth.alpha_r),
+            0.3,
+            200,
+            0.0,
+            700.0,
+            4,
+        );
+        let pairs: Vec<_> = m
+            .iter()
+            .map(|c| {
+                let (a, b) = cam.project(c.left[0], c.left[1]);
+                let (d, e) = cam.project(c.right[0], c.right[1]);
+                ([a, b], [d, e])
+            })
+            .collect();
+        let one_step = RefineConfig {
+            max_iterations: 1,
+            ..RefineConfig::default()
+        };
+        for ransac in [Some(RansacConfig::default()), None] {
+            let config = EstimatorConfig {
+                ransac,
+                refine: one_step,
+                ..EstimatorConfig::default()
+            };
+            let est = VergeEstimator::new(calib, config)
+                .estimate_from_pixels(&pairs)
+                .unwrap();
+            assert!((est.verge_deg - 15.0).abs() < 1e-6, "{ransac:?}: {est:?}");
+        }
+        let from_parallel = constrained::refine(
+            &pairs
+                .iter()
+                .map(|(l, r)| Correspondence::from_pixels(&calib, *l, *r))
+                .collect::<Vec<_>>(),
+            VergeAngles::new(0.0, 0.0),
+            &one_step,
+        )
+        .unwrap();
+        assert!((from_parallel.angles.verge_deg() - 15.0).abs() > 1e-3);
     }
 }

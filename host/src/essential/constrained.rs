@@ -75,7 +75,8 @@ pub fn linear(matches: &[Correspondence]) -> Result<VergeAngles, EssentialError>
     linear_weighted(matches, &weights)
 }
 
-/// [`linear`] with a non-negative weight per match (used by RANSAC on its inliers).
+/// [`linear`] with a non-negative weight per match (the estimator's start: RANSAC's inliers
+/// at their refinement weights, the others at zero).
 pub fn linear_weighted(
     matches: &[Correspondence],
     weights: &[f64],
