@@ -321,16 +321,22 @@ impl<D: Device> Session<D> {
     /// as dropped, its time unknown: the filter carries its state on to the next pair that
     /// has one. Waiting longer than the device's answer timeout is an error, as is a closed
     /// link: the caller decides whether that ends the stream.
+    ///
+    /// A head may have been streaming before this host connected: the first pair's id, not
+    /// 0, is where the session's numbering starts.
     pub fn receive(&mut self, frame: usize) -> Result<FrameRecord, SessionError> {
-        let expected = self.next_frame_id;
-        self.next_frame_id = expected.wrapping_add(1);
         let timeout = self.driver.link().answer_timeout();
+        let mut expected = self.next_frame_id;
         let outcome = loop {
             let outcome = match self.early.take() {
                 Some(outcome) => outcome,
                 None => self.driver.next_pair(timeout)?,
             };
             let got = outcome.frame_id();
+            if self.cost.pairs == 0 {
+                // No record yet: the device's numbering is adopted.
+                expected = got;
+            }
             // Ids wrap: "older" is within half the id space behind. An older pair is the rest
             // of one already recorded as dropped; a newer one waits for its own frame.
             if got == expected {
@@ -342,6 +348,7 @@ impl<D: Device> Session<D> {
                 break None;
             }
         };
+        self.next_frame_id = expected.wrapping_add(1);
         let start = Instant::now();
         let captured = match &outcome {
             Some(PairOutcome::Pair {

@@ -74,10 +74,26 @@ fn sorted_images(dir: &Path) -> Vec<Vec<u8>> {
 /// The head: answers the host through the in-process device until it is enabled, then
 /// grabs the first `pairs` pairs of `dir` as its cameras would, sends their packets and, when
 /// `close` is set, closes the link (a quiet head keeps it open until the host leaves).
-fn head(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool) {
+fn head(stream: impl TimedStream, dir: &Path, pairs: usize, close: bool) {
+    head_streaming_since(stream, dir, 0, pairs, close);
+}
+
+/// [`head`] that had streamed `before` pairs to nobody when the host connected, so its
+/// frame ids do not start at 0.
+fn head_streaming_since(
+    mut stream: impl TimedStream,
+    dir: &Path,
+    before: usize,
+    pairs: usize,
+    close: bool,
+) {
     let left = sorted_images(&dir.join("left"));
     let right = sorted_images(&dir.join("right"));
     let mut device = InProcessLink::new().unwrap();
+    for _ in 0..before {
+        device.submit_pair(&left[0], &right[0], 0).unwrap();
+        Device::take_sent(&mut device, &mut Vec::new()).unwrap();
+    }
     stream
         .set_receive_timeout(Duration::from_millis(10))
         .unwrap();
@@ -309,6 +325,44 @@ fn ctrl_c_ends_the_run_and_writes_what_arrived() {
         String::from_utf8_lossy(&live.stderr)
     );
     assert_eq!(raw_verges(&out_dir.join("verge.csv")).len(), 2);
+}
+
+#[test]
+fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("seq");
+    let (w, h) = synth(&seq);
+    let out_dir = dir.path().join("live");
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = listener.local_addr().unwrap().to_string();
+    let live = thread::scope(|scope| {
+        scope.spawn(|| {
+            let (stream, _) = listener.accept().unwrap();
+            head_streaming_since(stream, &seq, 5, 2, true);
+        });
+        stereocal(&[
+            "live",
+            "--tcp",
+            &addr,
+            "--calib",
+            seq.join("calib.toml").to_str().unwrap(),
+            "--width",
+            &w.to_string(),
+            "--height",
+            &h.to_string(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--json",
+        ])
+    });
+    assert!(
+        live.status.success(),
+        "{}",
+        String::from_utf8_lossy(&live.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&live.stdout).unwrap();
+    assert_eq!(summary["frames"], 2);
+    assert_eq!(summary["estimated_frames"], 2);
 }
 
 #[test]

@@ -302,8 +302,9 @@ fn gap(rng: &mut ChaCha8Rng, rate: f64) -> u64 {
         return 0;
     }
     let u: f64 = rng.random::<f64>();
-    // 1 - u is in (0, 1], so the logarithm is finite.
-    let n = ((1.0 - u).ln() / (1.0 - rate).ln()).floor();
+    // 1 - u is in (0, 1], so the logarithm is finite; ln_1p keeps a rate below f64's
+    // epsilon from rounding 1 - rate to 1 (a zero divisor: every trial an event).
+    let n = ((1.0 - u).ln() / (-rate).ln_1p()).floor();
     if n >= u64::MAX as f64 {
         u64::MAX
     } else {
@@ -357,5 +358,24 @@ impl<D: Device> Device for FaultLink<D> {
 
     fn answer_timeout(&self) -> Duration {
         self.inner.answer_timeout()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rate far below f64's epsilon still gives gaps of about 1/rate, not an event on
+    /// every trial (1 - rate rounds to 1).
+    #[test]
+    fn a_tiny_rate_gives_long_gaps() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let gaps: Vec<u64> = (0..64).map(|_| gap(&mut rng, 1e-18)).collect();
+        assert!(
+            gaps.iter().filter(|&&g| g > 1u64 << 50).count() > 48,
+            "{gaps:?}"
+        );
+        assert_eq!(gap(&mut rng, 0.0), u64::MAX);
+        assert_eq!(gap(&mut rng, 1.0), 0);
     }
 }
