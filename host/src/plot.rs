@@ -183,6 +183,7 @@ mod tests {
                         FrameStatus::Dropped
                     },
                     truth_deg: Some(v),
+                    dropped_because: None,
                 }
             })
             .collect();

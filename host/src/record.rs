@@ -56,4 +56,7 @@ pub struct FrameRecord {
     pub status: FrameStatus,
     /// Ground-truth verge, when a truth file or the renderer gives it.
     pub truth_deg: Option<f64>,
+    /// Why a `Dropped` pair was dropped, as the host driver found it (the first damage of
+    /// each damaged camera frame, or what never arrived); `None` otherwise.
+    pub dropped_because: Option<String>,
 }

@@ -304,12 +304,21 @@ impl<D: Device> Session<D> {
     /// Reads the pair back, estimates and filters it.
     fn finish(&mut self, pair: InFlight) -> Result<FrameRecord, SessionError> {
         let start = Instant::now();
-        let outcome = if pair.submitted {
-            self.receive_pair(pair.frame)?
+        let (outcome, missing) = if pair.submitted {
+            (
+                self.receive_pair(pair.frame)?,
+                "no complete pair arrived before the answer timeout",
+            )
         } else {
-            None
+            (None, "the grabber lost the pair")
         };
-        let record = self.conclude(pair.frame, outcome, pair.timestamp_us, pair.truth_deg)?;
+        let record = self.conclude(
+            pair.frame,
+            outcome,
+            missing,
+            pair.timestamp_us,
+            pair.truth_deg,
+        )?;
         self.cost.elapsed += start.elapsed();
         Ok(record)
     }
@@ -357,16 +366,24 @@ impl<D: Device> Session<D> {
             }) => left.features.timestamp_us,
             _ => self.last_timestamp_us.unwrap_or(0),
         };
-        let record = self.conclude(frame, outcome, captured, None)?;
+        let record = self.conclude(
+            frame,
+            outcome,
+            "the device skipped its frame id (its packets were lost on the link)",
+            captured,
+            None,
+        )?;
         self.cost.elapsed += start.elapsed();
         Ok(record)
     }
 
-    /// Estimates and filters one pair's outcome (`None`: nothing arrived) into its record.
+    /// Estimates and filters one pair's outcome into its record; `missing` says why there is
+    /// none when `outcome` is `None`.
     fn conclude(
         &mut self,
         frame: usize,
         outcome: Option<PairOutcome>,
+        missing: &str,
         timestamp_us: u64,
         truth_deg: Option<f64>,
     ) -> Result<FrameRecord, SessionError> {
@@ -381,6 +398,11 @@ impl<D: Device> Session<D> {
             matches_per_octave: Vec::new(),
             status: FrameStatus::Dropped,
             truth_deg,
+            dropped_because: None,
+        };
+        record.dropped_because = match &outcome {
+            Some(outcome) => damage_of(outcome),
+            None => Some(missing.to_owned()),
         };
         let measurement = match outcome {
             Some(PairOutcome::Pair {
@@ -481,5 +503,28 @@ impl<D: Device> Session<D> {
                 });
             }
         }
+    }
+}
+
+/// What the driver found wrong with a pair, `None` when both camera frames arrived whole.
+fn damage_of(outcome: &PairOutcome) -> Option<String> {
+    let damaged = |f: &FrameOutcome| match f {
+        FrameOutcome::Delivered(_) => None,
+        FrameOutcome::Damaged(d) => Some(format!(
+            "{:?} camera frame {} damaged: {}",
+            d.camera, d.frame_id, d.damage
+        )),
+    };
+    match outcome {
+        PairOutcome::Pair { left, right } => {
+            let found: Vec<String> = [left, right].into_iter().filter_map(damaged).collect();
+            (!found.is_empty()).then(|| found.join("; "))
+        }
+        PairOutcome::Single(f) => Some(format!(
+            "only the {:?} camera's frame {} arrived{}",
+            f.camera(),
+            f.frame_id(),
+            damaged(f).map_or(String::new(), |d| format!(" ({d})"))
+        )),
     }
 }

@@ -162,6 +162,7 @@ mod tests {
             matches_per_octave: Vec::new(),
             status,
             truth_deg: Some(truth),
+            dropped_because: None,
         }
     }
 

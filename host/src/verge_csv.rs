@@ -137,6 +137,7 @@ mod tests {
                 matches_per_octave: Vec::new(),
                 status: FrameStatus::Ok,
                 truth_deg: None,
+                dropped_because: None,
             },
             FrameRecord {
                 frame: 1,
@@ -149,6 +150,7 @@ mod tests {
                 matches_per_octave: Vec::new(),
                 status: FrameStatus::NoEstimate,
                 truth_deg: None,
+                dropped_because: None,
             },
         ];
         let mut out = Vec::new();

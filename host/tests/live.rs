@@ -75,22 +75,23 @@ fn sorted_images(dir: &Path) -> Vec<Vec<u8>> {
 /// grabs the first `pairs` pairs of `dir` as its cameras would, sends their packets and, when
 /// `close` is set, closes the link (a quiet head keeps it open until the host leaves).
 fn head(stream: impl TimedStream, dir: &Path, pairs: usize, close: bool) {
-    head_streaming_since(stream, dir, 0, pairs, close);
+    head_with(stream, dir, pairs, close, Quirks::default());
 }
 
-/// [`head`] that had streamed `before` pairs to nobody when the host connected, so its
-/// frame ids do not start at 0.
-fn head_streaming_since(
-    mut stream: impl TimedStream,
-    dir: &Path,
+/// What a head may do besides streaming cleanly.
+#[derive(Default, Clone, Copy)]
+struct Quirks {
+    /// Pairs it had streamed to nobody when the host connected (its ids do not start at 0).
     before: usize,
-    pairs: usize,
-    close: bool,
-) {
+    /// A pair whose bytes it damages (one byte in the middle flipped) on the way out.
+    damage: Option<usize>,
+}
+
+fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool, q: Quirks) {
     let left = sorted_images(&dir.join("left"));
     let right = sorted_images(&dir.join("right"));
     let mut device = InProcessLink::new().unwrap();
-    for _ in 0..before {
+    for _ in 0..q.before {
         device.submit_pair(&left[0], &right[0], 0).unwrap();
         Device::take_sent(&mut device, &mut Vec::new()).unwrap();
     }
@@ -107,21 +108,31 @@ fn head_streaming_since(
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
             Err(_) => return,
         }
+        let mut send = |device: &mut InProcessLink, damage: bool| {
+            out.clear();
+            Device::take_sent(device, &mut out).unwrap();
+            if damage {
+                let middle = out.len() / 2;
+                out[middle] ^= 0x5a;
+            }
+            stream.write_all(&out).is_ok()
+        };
+        if !send(&mut device, false) {
+            return;
+        }
         if device.enabled() && !grabbed {
             grabbed = true;
             for (i, (l, r)) in left.iter().zip(&right).take(pairs).enumerate() {
                 device
                     .submit_pair(l, r, (i as f64 * PERIOD_US).round() as u64)
                     .unwrap();
+                if !send(&mut device, q.damage == Some(i)) {
+                    return;
+                }
             }
-        }
-        out.clear();
-        Device::take_sent(&mut device, &mut out).unwrap();
-        if stream.write_all(&out).is_err() {
-            return;
-        }
-        if grabbed && close {
-            return;
+            if close {
+                return;
+            }
         }
     }
 }
@@ -338,7 +349,11 @@ fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
     let live = thread::scope(|scope| {
         scope.spawn(|| {
             let (stream, _) = listener.accept().unwrap();
-            head_streaming_since(stream, &seq, 5, 2, true);
+            let quirks = Quirks {
+                before: 5,
+                ..Quirks::default()
+            };
+            head_with(stream, &seq, 2, true, quirks);
         });
         stereocal(&[
             "live",
@@ -363,6 +378,56 @@ fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
     let summary: serde_json::Value = serde_json::from_slice(&live.stdout).unwrap();
     assert_eq!(summary["frames"], 2);
     assert_eq!(summary["estimated_frames"], 2);
+}
+
+#[test]
+fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = dir.path().join("seq");
+    let (w, h) = synth(&seq);
+    let out_dir = dir.path().join("live");
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = listener.local_addr().unwrap().to_string();
+    let live = thread::scope(|scope| {
+        scope.spawn(|| {
+            let (stream, _) = listener.accept().unwrap();
+            let quirks = Quirks {
+                damage: Some(1),
+                ..Quirks::default()
+            };
+            head_with(stream, &seq, 3, true, quirks);
+        });
+        stereocal(&[
+            "live",
+            "--tcp",
+            &addr,
+            "--calib",
+            seq.join("calib.toml").to_str().unwrap(),
+            "--width",
+            &w.to_string(),
+            "--height",
+            &h.to_string(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ])
+    });
+    assert!(
+        live.status.success(),
+        "{}",
+        String::from_utf8_lossy(&live.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&live.stderr);
+    assert!(
+        stderr.contains("frame 1: dropped: ") && stderr.contains("damaged"),
+        "{stderr}"
+    );
+    let csv = std::fs::read_to_string(out_dir.join("verge.csv")).unwrap();
+    let status: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap())
+        .collect();
+    assert_eq!(status, ["ok", "dropped", "ok"], "{csv}");
 }
 
 #[test]

@@ -17,7 +17,7 @@ use stereocal::session::{Session, SessionError};
 use stereocal::summary::{Residual, Summary};
 
 use super::options::EstimateArgs;
-use super::output::{finish, progress_bar, Finish};
+use super::output::{finish, keep, progress_bar, Finish};
 
 #[derive(Debug, Clone, Args)]
 #[command(group(ArgGroup::new("link").required(true).args(["serial", "tcp", "unix"])))]
@@ -96,10 +96,7 @@ pub fn live(args: &LiveArgs) -> anyhow::Result<()> {
     let mut stopped = None;
     while args.frames.is_none_or(|n| records.len() < n) && !interrupted.load(Ordering::Relaxed) {
         match session.receive(records.len()) {
-            Ok(record) => {
-                bar.inc(1);
-                records.push(record);
-            }
+            Ok(record) => keep(&mut records, record, &bar),
             Err(SessionError::Driver(DriverError::Link(LinkError::Closed { .. })))
                 if args.frames.is_none() && !records.is_empty() =>
             {

@@ -32,6 +32,16 @@ pub fn progress_bar(len: u64, message: &'static str) -> ProgressBar {
     bar
 }
 
+/// Adds `record` to `records`, saying on stderr why its pair was dropped if it was (above
+/// the progress bar, which stays).
+pub fn keep(records: &mut Vec<FrameRecord>, record: FrameRecord, bar: &ProgressBar) {
+    if let Some(why) = &record.dropped_because {
+        bar.suspend(|| eprintln!("frame {}: dropped: {why}", record.frame));
+    }
+    bar.inc(1);
+    records.push(record);
+}
+
 /// Writes the files (all or none), then prints the summary.
 pub fn finish(
     records: &[FrameRecord],

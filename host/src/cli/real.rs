@@ -14,7 +14,7 @@ use stereocal::verge_csv::read_truth_csv;
 use stereocal_hdl::regs::{MAX_HEIGHT, MAX_WIDTH, MIN_SIDE};
 
 use super::options::EstimateArgs;
-use super::output::{finish, progress_bar, Finish};
+use super::output::{finish, keep, progress_bar, Finish};
 
 /// Pairs decoded ahead of the chain.
 const LOOKAHEAD: usize = 3;
@@ -127,13 +127,11 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 truth.as_ref().map(|t| t[frame]),
             )?;
             if let Some(record) = record {
-                bar.inc(1);
-                records.push(record);
+                keep(&mut records, record, &bar);
             }
         }
         while let Some(record) = session.flush()? {
-            bar.inc(1);
-            records.push(record);
+            keep(&mut records, record, &bar);
         }
         Ok(records)
     })?;

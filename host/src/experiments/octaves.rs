@@ -285,6 +285,7 @@ mod tests {
             matches_per_octave: matches,
             status,
             truth_deg: None,
+            dropped_because: None,
         }
     }
 
