@@ -4,6 +4,7 @@
 //! each flag only moves away from them.
 
 use clap::{Args, ValueEnum};
+use stereocal::descriptor::DescriptorMode;
 use stereocal::estimator::Model;
 use stereocal::session::SessionConfig;
 use stereocal_hdl::regs::output_mode::SobelOutput;
@@ -26,6 +27,16 @@ pub enum SobelArg {
     Patches,
 }
 
+/// Descriptor layout (`--descriptor`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DescriptorArg {
+    /// 4x4 cells x 8 orientation bins = 128 elements (Lowe, thesis 4.4.2).
+    Full,
+    /// 2x2 cells x 4 orientation bins = 16 elements (thesis 6.3; less to compare, less
+    /// distinctive).
+    Reduced16,
+}
+
 #[derive(Debug, Clone, Args)]
 pub struct EstimateArgs {
     /// Robust RANSAC start for the refinement (the default; `--no-ransac` turns it off).
@@ -40,6 +51,23 @@ pub struct EstimateArgs {
     /// Keep only the N best matches (default: every match that passes the tests).
     #[arg(long, value_parser = parse_best)]
     best: Option<usize>,
+    /// Left-right consistency off: a left point's best right match need not choose it back.
+    #[arg(long)]
+    no_cross_check: bool,
+    /// Vertical-disparity gate: right candidates within this many pixels of the left point's
+    /// row (full resolution).
+    #[arg(long, default_value_t = 24.0, value_parser = parse_pixels)]
+    max_vertical_px: f32,
+    /// No vertical-disparity gate: every right point is a candidate.
+    #[arg(long, conflicts_with = "max_vertical_px")]
+    no_vertical_gate: bool,
+    /// Descriptor layout.
+    #[arg(long, value_enum, default_value_t = DescriptorArg::Full)]
+    descriptor: DescriptorArg,
+    /// Rotate each descriptor window to the keypoint's dominant gradient orientation (off:
+    /// the unrotated mode, right for a head whose cameras do not roll).
+    #[arg(long)]
+    rotate: bool,
     /// Essential-matrix model.
     #[arg(long, value_enum, default_value_t = ModelArg::Constrained)]
     model: ModelArg,
@@ -57,6 +85,13 @@ impl EstimateArgs {
         }
         e.matching.ratio = self.ratio;
         e.matching.best_n = self.best;
+        e.matching.cross_check = !self.no_cross_check;
+        e.matching.max_vertical_px = (!self.no_vertical_gate).then_some(self.max_vertical_px);
+        e.descriptor.mode = match self.descriptor {
+            DescriptorArg::Full => DescriptorMode::Full128,
+            DescriptorArg::Reduced16 => DescriptorMode::Reduced16,
+        };
+        e.descriptor.rotate = self.rotate;
         e.model = match self.model {
             ModelArg::Constrained => Model::Constrained,
             ModelArg::General => Model::General,
@@ -75,6 +110,15 @@ fn parse_ratio(s: &str) -> Result<f32, String> {
         Ok(r)
     } else {
         Err(format!("{r} is outside (0, 1)"))
+    }
+}
+
+fn parse_pixels(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not a distance in pixels"))
     }
 }
 
