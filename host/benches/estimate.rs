@@ -23,8 +23,16 @@ const H: u32 = 480;
 const KEYPOINTS: usize = 500;
 const DISPARITY: i32 = 9;
 
-/// A smooth random gradient field; `shift` moves the content left by that many pixels.
-fn plane(seed: u64, shift: i32) -> SobelPlane {
+/// Disparity of image row `y`: a slanted plane, like a road, nearer at the bottom. A constant
+/// disparity (a fronto-parallel plane) would leave the verge undetermined: every verge in a
+/// one-parameter family fits such matches exactly.
+fn disparity(y: i32) -> i32 {
+    DISPARITY + y / 40
+}
+
+/// A smooth random gradient field; `shift(y)` moves row `y`'s content left by that many
+/// pixels.
+fn plane(seed: u64, shift: impl Fn(i32) -> i32) -> SobelPlane {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let waves: Vec<(f32, f32, f32, f32)> = (0..12)
         .map(|_| {
@@ -40,7 +48,7 @@ fn plane(seed: u64, shift: i32) -> SobelPlane {
     let mut ori = Vec::with_capacity((W * H) as usize);
     for y in 0..H as i32 {
         for x in 0..W as i32 {
-            let xs = (x + shift) as f32;
+            let xs = (x + shift(y)) as f32;
             let v: f32 = waves
                 .iter()
                 .map(|(a, b, p, amp)| amp * (a * xs + b * y as f32 + p).sin())
@@ -68,18 +76,18 @@ fn frames() -> (FeatureFrame, FeatureFrame) {
         };
         left.push(k);
         right.push(Keypoint {
-            x: x - DISPARITY as f32,
+            x: x - disparity(y as i32) as f32,
             ..k
         });
     }
-    let lf = FeatureFrame::new(0, 0, W, H, left, Gradients::Planes(vec![plane(7, 0)]));
+    let lf = FeatureFrame::new(0, 0, W, H, left, Gradients::Planes(vec![plane(7, |_| 0)]));
     let rf = FeatureFrame::new(
         0,
         0,
         W,
         H,
         right,
-        Gradients::Planes(vec![plane(7, DISPARITY)]),
+        Gradients::Planes(vec![plane(7, disparity)]),
     );
     (lf.expect("left frame"), rf.expect("right frame"))
 }

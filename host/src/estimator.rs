@@ -253,8 +253,10 @@ impl VergeEstimator {
         let focal = 0.5 * (self.calib.left.focal_px() + self.calib.right.focal_px());
         // The thesis' solve (4.5): e1..e4 by SVD, rank 2 enforced, the 180° ambiguity
         // resolved, over RANSAC's consensus set (or every match without RANSAC), each match
-        // weighted as the refinement weighs it. Its angles start the refinement; should the
-        // set be degenerate, RANSAC's own hypothesis (or the parallel head) does.
+        // weighted as the refinement weighs it. Its angles start the refinement, and so does
+        // RANSAC's own hypothesis (or the parallel head): on a near-planar scene the linear
+        // system loses rank and its solution can be far off, and without RANSAC it also saw
+        // the outliers. The lower robust cost wins.
         let (consensus, fallback) = match self.config.ransac {
             Some(cfg) => {
                 let cfg = RansacConfig {
@@ -272,16 +274,10 @@ impl VergeEstimator {
             .map(|(c, &inlier)| if inlier { c.weight } else { 0.0 })
             .collect();
         let linear = constrained::linear_weighted(&corr, &linear_weights).unwrap_or(fallback);
-        // Without RANSAC the linear solve saw the outliers too, so the parallel head is a
-        // second start; the lower robust cost wins.
-        let starts: &[VergeAngles] = match self.config.ransac {
-            Some(_) => &[linear],
-            None => &[linear, fallback],
-        };
         let cfit = lowest_cost(
-            starts
-                .iter()
-                .map(|s| constrained::refine(&corr, *s, &self.config.refine)),
+            [linear, fallback]
+                .into_iter()
+                .map(|s| constrained::refine(&corr, s, &self.config.refine)),
             &corr,
             |f| (f.residual_sigma, f.angles.essential()),
         )?;
