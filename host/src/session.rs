@@ -404,6 +404,17 @@ impl<D: Device> Session<D> {
             Some(outcome) => damage_of(outcome),
             None => Some(missing.to_owned()),
         };
+        // What the device said on its own since the last pair (a frame it could not run)
+        // explains a drop better than the host's view of the bytes.
+        let reports = self.driver.take_device_errors();
+        if let (Some(why), false) = (&mut record.dropped_because, reports.is_empty()) {
+            for r in reports {
+                why.push_str(&format!(
+                    "; the device reported {:?} (detail {:#x}) in packet seq {}",
+                    r.report.code, r.report.detail, r.seq
+                ));
+            }
+        }
         let measurement = match outcome {
             Some(PairOutcome::Pair {
                 left: FrameOutcome::Delivered(left),

@@ -403,3 +403,25 @@ fn packets_of_an_unknown_kind_are_counted_not_damage() {
     let s = d.stats();
     assert_eq!((s.unknown_kinds, s.undecodable, s.sequence_gaps), (1, 0, 0));
 }
+
+#[test]
+fn error_reports_outside_a_request_are_kept_bounded_to_the_newest() {
+    use stereocal_wire::{ErrorCode, ErrorReportRepr, PacketRepr};
+    let mut wire = Wire::new();
+    for detail in 0..100 {
+        wire.push(&PacketRepr::ErrorReport(ErrorReportRepr {
+            code: ErrorCode::Busy,
+            detail,
+        }));
+    }
+    wire.frame(&FrameSpec::small(1, Camera::Left));
+    let mut d = driver(&wire);
+    delivered(d.next_frame(T).unwrap());
+    let reports = d.take_device_errors();
+    // A bounded list: the newest 64 of the 100 the device sent.
+    assert_eq!(reports.len(), 64);
+    assert_eq!(reports[0].report.detail, 36);
+    assert_eq!(reports[63].report.detail, 99);
+    assert_eq!(reports[63].seq, 99);
+    assert!(d.take_device_errors().is_empty());
+}

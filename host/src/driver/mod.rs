@@ -101,6 +101,9 @@ impl PairOutcome {
     }
 }
 
+/// Unclaimed device `ErrorReport`s kept (the newest).
+const MAX_DEVICE_ERRORS: usize = 64;
+
 /// An `ErrorReport` the device sent outside a request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DeviceReport {
@@ -414,6 +417,11 @@ impl<L: Link> Driver<L> {
                     self.logs.push_back(log);
                 }
                 Event::DeviceError { seq, report } => {
+                    // A device that reports on every frame while nobody takes the reports
+                    // must not grow the host without bound: the oldest go first.
+                    if self.device_errors.len() == MAX_DEVICE_ERRORS {
+                        self.device_errors.remove(0);
+                    }
                     self.device_errors.push(DeviceReport { seq, report })
                 }
             }
