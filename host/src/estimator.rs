@@ -474,6 +474,33 @@ mod tests {
     use crate::essential::rot_y;
     use crate::essential::testutil::synthetic;
 
+    /// `n` exact matches of a head verged by `truth`, in the pixels of `calib`'s cameras
+    /// (distortion applied), as the matcher would hand them over.
+    fn pixel_matches(
+        calib: &Calibration,
+        truth: VergeAngles,
+        n: usize,
+        seed: u64,
+    ) -> Vec<([f64; 2], [f64; 2])> {
+        let (l, r) = (calib.left, calib.right);
+        synthetic(
+            rot_y(truth.alpha_l),
+            rot_y(truth.alpha_r),
+            calib.baseline_m,
+            n,
+            0.0,
+            l.fx,
+            seed,
+        )
+        .iter()
+        .map(|c| {
+            let (a, b) = l.project(c.left[0], c.left[1]);
+            let (d, e) = r.project(c.right[0], c.right[1]);
+            ([a, b], [d, e])
+        })
+        .collect()
+    }
+
     #[test]
     fn pixel_pipeline_recovers_verge_with_distortion() {
         let cam = CameraIntrinsics {
@@ -489,23 +516,7 @@ mod tests {
             right: cam,
         };
         let truth = VergeAngles::new(1.2f64.to_radians(), -0.7f64.to_radians());
-        let m = synthetic(
-            rot_y(truth.alpha_l),
-            rot_y(truth.alpha_r),
-            0.11,
-            600,
-            0.0,
-            458.0,
-            9,
-        );
-        let pairs: Vec<_> = m
-            .iter()
-            .map(|c| {
-                let (a, b) = cam.project(c.left[0], c.left[1]);
-                let (d, e) = cam.project(c.right[0], c.right[1]);
-                ([a, b], [d, e])
-            })
-            .collect();
+        let pairs = pixel_matches(&calib, truth, 600, 9);
         let est = VergeEstimator::new(calib, EstimatorConfig::default())
             .estimate_from_pixels(&pairs)
             .unwrap();
@@ -539,23 +550,7 @@ mod tests {
             right: cam,
         };
         let truth = VergeAngles::new(9f64.to_radians(), -6f64.to_radians());
-        let m = synthetic(
-            rot_y(truth.alpha_l),
-            rot_y(truth.alpha_r),
-            0.3,
-            200,
-            0.0,
-            700.0,
-            4,
-        );
-        let pairs: Vec<_> = m
-            .iter()
-            .map(|c| {
-                let (a, b) = cam.project(c.left[0], c.left[1]);
-                let (d, e) = cam.project(c.right[0], c.right[1]);
-                ([a, b], [d, e])
-            })
-            .collect();
+        let pairs = pixel_matches(&calib, truth, 200, 4);
         let one_step = RefineConfig {
             max_iterations: 1,
             ..RefineConfig::default()

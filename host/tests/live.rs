@@ -246,8 +246,16 @@ fn live_over_a_serial_port_estimates_what_run_does() {
     );
 }
 
-#[test]
-fn a_quiet_head_times_out_naming_the_link_and_keeps_what_arrived() {
+/// A rendered sequence served over TCP by a head that grabs `pairs` pairs with `quirks` (and
+/// closes the link after them when `close` is set), and `stereocal live` on it with `extra`
+/// arguments; the run's outputs go to `live/` in the returned directory, beside the head's
+/// address.
+fn live_on_a_tcp_head(
+    pairs: usize,
+    close: bool,
+    quirks: Quirks,
+    extra: &[&str],
+) -> (Output, tempfile::TempDir, String) {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("seq");
     let (w, h) = synth(&seq);
@@ -257,26 +265,33 @@ fn a_quiet_head_times_out_naming_the_link_and_keeps_what_arrived() {
     let live = thread::scope(|scope| {
         scope.spawn(|| {
             let (stream, _) = listener.accept().unwrap();
-            head(stream, &seq, 2, false);
+            head_with(stream, &seq, pairs, close, quirks);
         });
-        stereocal(&[
+        let (w, h) = (w.to_string(), h.to_string());
+        let calib = seq.join("calib.toml");
+        let mut args = vec![
             "live",
             "--tcp",
             &addr,
             "--calib",
-            seq.join("calib.toml").to_str().unwrap(),
+            calib.to_str().unwrap(),
             "--width",
-            &w.to_string(),
+            &w,
             "--height",
-            &h.to_string(),
-            "--frames",
-            "3",
-            "--timeout-ms",
-            "500",
+            &h,
             "--out",
             out_dir.to_str().unwrap(),
-        ])
+        ];
+        args.extend_from_slice(extra);
+        stereocal(&args)
     });
+    (live, dir, addr)
+}
+
+#[test]
+fn a_quiet_head_times_out_naming_the_link_and_keeps_what_arrived() {
+    let extra = ["--frames", "3", "--timeout-ms", "500"];
+    let (live, dir, addr) = live_on_a_tcp_head(2, false, Quirks::default(), &extra);
     assert!(!live.status.success());
     let stderr = String::from_utf8_lossy(&live.stderr);
     assert!(
@@ -284,7 +299,7 @@ fn a_quiet_head_times_out_naming_the_link_and_keeps_what_arrived() {
         "{stderr}"
     );
     assert!(stderr.contains("stopped after 2 frame pairs"), "{stderr}");
-    assert_eq!(raw_verges(&out_dir.join("verge.csv")).len(), 2);
+    assert_eq!(raw_verges(&dir.path().join("live/verge.csv")).len(), 2);
 }
 
 #[cfg(unix)]
@@ -340,36 +355,11 @@ fn ctrl_c_ends_the_run_and_writes_what_arrived() {
 
 #[test]
 fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
-    let dir = tempfile::tempdir().unwrap();
-    let seq = dir.path().join("seq");
-    let (w, h) = synth(&seq);
-    let out_dir = dir.path().join("live");
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    let addr = listener.local_addr().unwrap().to_string();
-    let live = thread::scope(|scope| {
-        scope.spawn(|| {
-            let (stream, _) = listener.accept().unwrap();
-            let quirks = Quirks {
-                before: 5,
-                ..Quirks::default()
-            };
-            head_with(stream, &seq, 2, true, quirks);
-        });
-        stereocal(&[
-            "live",
-            "--tcp",
-            &addr,
-            "--calib",
-            seq.join("calib.toml").to_str().unwrap(),
-            "--width",
-            &w.to_string(),
-            "--height",
-            &h.to_string(),
-            "--out",
-            out_dir.to_str().unwrap(),
-            "--json",
-        ])
-    });
+    let quirks = Quirks {
+        before: 5,
+        ..Quirks::default()
+    };
+    let (live, _dir, _) = live_on_a_tcp_head(2, true, quirks, &["--json"]);
     assert!(
         live.status.success(),
         "{}",
@@ -382,35 +372,11 @@ fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
 
 #[test]
 fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
-    let dir = tempfile::tempdir().unwrap();
-    let seq = dir.path().join("seq");
-    let (w, h) = synth(&seq);
-    let out_dir = dir.path().join("live");
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    let addr = listener.local_addr().unwrap().to_string();
-    let live = thread::scope(|scope| {
-        scope.spawn(|| {
-            let (stream, _) = listener.accept().unwrap();
-            let quirks = Quirks {
-                damage: Some(1),
-                ..Quirks::default()
-            };
-            head_with(stream, &seq, 3, true, quirks);
-        });
-        stereocal(&[
-            "live",
-            "--tcp",
-            &addr,
-            "--calib",
-            seq.join("calib.toml").to_str().unwrap(),
-            "--width",
-            &w.to_string(),
-            "--height",
-            &h.to_string(),
-            "--out",
-            out_dir.to_str().unwrap(),
-        ])
-    });
+    let quirks = Quirks {
+        damage: Some(1),
+        ..Quirks::default()
+    };
+    let (live, dir, _) = live_on_a_tcp_head(3, true, quirks, &[]);
     assert!(
         live.status.success(),
         "{}",
@@ -421,7 +387,7 @@ fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
         stderr.contains("frame 1: dropped: ") && stderr.contains("damaged"),
         "{stderr}"
     );
-    let csv = std::fs::read_to_string(out_dir.join("verge.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("live/verge.csv")).unwrap();
     let status: Vec<&str> = csv
         .lines()
         .skip(1)
