@@ -4,6 +4,7 @@
 //! place only when every one of them was written, so an error (or Ctrl-C) part-way through a run
 //! never leaves a half-written `verge.csv` beside a stale `verge.png`.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// An output directory that could not be prepared or committed.
@@ -70,6 +71,36 @@ impl StagedOutput {
     }
 }
 
+/// Replaces the file at `path` with `contents` by one rename from a temporary file beside it,
+/// so an error or a kill part-way leaves the previous file whole (a document in the
+/// repository, say, that a long run regenerates).
+pub fn write_atomically(path: &Path, contents: &[u8]) -> Result<(), OutputError> {
+    let err = |action| {
+        move |source| OutputError {
+            path: path.to_owned(),
+            action,
+            source,
+        }
+    };
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".stereocal-staging-");
+    // The mode `fs::write` would give (0o666 less the umask), not a temporary file's 0o600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut file = builder
+        .tempfile_in(dir)
+        .map_err(err("cannot create a temporary file beside it"))?;
+    file.write_all(contents)
+        .map_err(err("cannot write the temporary file"))?;
+    file.persist(path)
+        .map_err(|e| err("cannot move the finished file into place")(e.error))?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,5 +127,18 @@ mod tests {
         std::fs::write(staged.path("a.csv"), "x").unwrap();
         drop(staged);
         assert_eq!(std::fs::read_dir(&dest).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn a_file_written_atomically_replaces_the_old_one_and_leaves_nothing_beside_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("doc.md");
+        std::fs::write(&path, "old").unwrap();
+        write_atomically(&path, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        let missing = dir.path().join("no-such-dir").join("doc.md");
+        let e = write_atomically(&missing, b"x").unwrap_err();
+        assert!(e.to_string().contains("no-such-dir"), "{e}");
     }
 }

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use stereocal::output_dir::write_atomically;
 use stereocal::reliability::{markdown, passed, sweep, sweep_runs, FaultKind, SweepConfig};
 use stereocal::soak::{self, SoakConfig};
 
@@ -91,8 +92,7 @@ pub fn reliability(args: &ReliabilityArgs) -> anyhow::Result<()> {
     {
         text = soak::splice(&text, section);
     }
-    std::fs::write(&args.out, &text)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    write_atomically(&args.out, text.as_bytes())?;
     print!("{text}");
     eprintln!("wrote {}", args.out.display());
     anyhow::ensure!(
@@ -134,8 +134,7 @@ fn run_soak(args: &ReliabilityArgs, frames: u32) -> anyhow::Result<()> {
             return Err(e).with_context(|| format!("cannot read {}", args.out.display()));
         }
     };
-    std::fs::write(&args.out, soak::splice(&doc, &section))
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    write_atomically(&args.out, soak::splice(&doc, &section).as_bytes())?;
     print!("{section}");
     eprintln!("wrote the soak section of {}", args.out.display());
     anyhow::ensure!(
