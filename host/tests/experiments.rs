@@ -21,6 +21,14 @@ fn per_octave_counts_sum_to_the_matches() {
         .filter(|r| r.status == FrameStatus::Ok)
         .collect();
     assert!(!estimated.is_empty());
+    // Points from every octave: the coarser ones are not built for nothing.
+    for octave in 1..MAX_OCTAVES as usize {
+        let matched: usize = estimated.iter().map(|r| r.matches_per_octave[octave]).sum();
+        assert!(
+            matched > 0,
+            "octave {octave} matched nothing: {estimated:?}"
+        );
+    }
     for r in estimated {
         assert_eq!(r.matches_per_octave.len(), MAX_OCTAVES as usize, "{r:?}");
         assert_eq!(
