@@ -7,7 +7,7 @@
 
 use std::io::ErrorKind;
 use std::net::TcpListener;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::thread;
 use std::time::Duration;
@@ -246,92 +246,106 @@ fn live_over_a_serial_port_estimates_what_run_does() {
     );
 }
 
-/// A rendered sequence served over TCP by a head that grabs `pairs` pairs with `quirks` (and
-/// closes the link after them when `close` is set), and `stereocal live` on it with `extra`
-/// arguments; the run's outputs go to `live/` in the returned directory, beside the head's
-/// address.
+/// A rendered sequence in a temporary directory and a TCP listener its head will serve on.
+struct TcpHeadSetup {
+    dir: tempfile::TempDir,
+    seq: PathBuf,
+    /// The frames' width and height, as `live` takes them.
+    size: (String, String),
+    listener: TcpListener,
+    addr: String,
+}
+
+impl TcpHeadSetup {
+    fn new() -> Self {
+        let dir = tempfile::tempdir().unwrap();
+        let seq = dir.path().join("seq");
+        let (w, h) = synth(&seq);
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        Self {
+            dir,
+            seq,
+            size: (w.to_string(), h.to_string()),
+            listener,
+            addr,
+        }
+    }
+
+    /// Where `live` writes its outputs.
+    fn out_dir(&self) -> PathBuf {
+        self.dir.path().join("live")
+    }
+
+    /// `live`'s arguments for this head, up to its optional flags.
+    fn live_args<'a>(&'a self, calib: &'a Path, out_dir: &'a Path) -> Vec<&'a str> {
+        vec![
+            "live",
+            "--tcp",
+            &self.addr,
+            "--calib",
+            calib.to_str().unwrap(),
+            "--width",
+            &self.size.0,
+            "--height",
+            &self.size.1,
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]
+    }
+}
+
+/// A head serving the rendered sequence over TCP, grabbing `pairs` pairs with `quirks` (and
+/// closing the link after them when `close` is set), and `stereocal live` on it with `extra`
+/// arguments.
 fn live_on_a_tcp_head(
     pairs: usize,
     close: bool,
     quirks: Quirks,
     extra: &[&str],
-) -> (Output, tempfile::TempDir, String) {
-    let dir = tempfile::tempdir().unwrap();
-    let seq = dir.path().join("seq");
-    let (w, h) = synth(&seq);
-    let out_dir = dir.path().join("live");
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    let addr = listener.local_addr().unwrap().to_string();
+) -> (Output, TcpHeadSetup) {
+    let setup = TcpHeadSetup::new();
     let live = thread::scope(|scope| {
         scope.spawn(|| {
-            let (stream, _) = listener.accept().unwrap();
-            head_with(stream, &seq, pairs, close, quirks);
+            let (stream, _) = setup.listener.accept().unwrap();
+            head_with(stream, &setup.seq, pairs, close, quirks);
         });
-        let (w, h) = (w.to_string(), h.to_string());
-        let calib = seq.join("calib.toml");
-        let mut args = vec![
-            "live",
-            "--tcp",
-            &addr,
-            "--calib",
-            calib.to_str().unwrap(),
-            "--width",
-            &w,
-            "--height",
-            &h,
-            "--out",
-            out_dir.to_str().unwrap(),
-        ];
+        let (calib, out_dir) = (setup.seq.join("calib.toml"), setup.out_dir());
+        let mut args = setup.live_args(&calib, &out_dir);
         args.extend_from_slice(extra);
         stereocal(&args)
     });
-    (live, dir, addr)
+    (live, setup)
 }
 
 #[test]
 fn a_quiet_head_times_out_naming_the_link_and_keeps_what_arrived() {
     let extra = ["--frames", "3", "--timeout-ms", "500"];
-    let (live, dir, addr) = live_on_a_tcp_head(2, false, Quirks::default(), &extra);
+    let (live, setup) = live_on_a_tcp_head(2, false, Quirks::default(), &extra);
     assert!(!live.status.success());
     let stderr = String::from_utf8_lossy(&live.stderr);
     assert!(
-        stderr.contains(&format!("frame 2 on tcp {addr}")) && stderr.contains("timed out"),
+        stderr.contains(&format!("frame 2 on tcp {}", setup.addr)) && stderr.contains("timed out"),
         "{stderr}"
     );
     assert!(stderr.contains("stopped after 2 frame pairs"), "{stderr}");
-    assert_eq!(raw_verges(&dir.path().join("live/verge.csv")).len(), 2);
+    assert_eq!(raw_verges(&setup.out_dir().join("verge.csv")).len(), 2);
 }
 
 #[cfg(unix)]
 #[test]
 fn ctrl_c_ends_the_run_and_writes_what_arrived() {
-    let dir = tempfile::tempdir().unwrap();
-    let seq = dir.path().join("seq");
-    let (w, h) = synth(&seq);
-    let out_dir = dir.path().join("live");
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    let addr = listener.local_addr().unwrap().to_string();
+    let setup = TcpHeadSetup::new();
+    let (calib, out_dir) = (setup.seq.join("calib.toml"), setup.out_dir());
     let live = thread::scope(|scope| {
         scope.spawn(|| {
-            let (stream, _) = listener.accept().unwrap();
-            head(stream, &seq, 2, false);
+            let (stream, _) = setup.listener.accept().unwrap();
+            head(stream, &setup.seq, 2, false);
         });
+        let mut args = setup.live_args(&calib, &out_dir);
+        args.extend(["--timeout-ms", "3000"]);
         let child = Command::new(BIN)
-            .args([
-                "live",
-                "--tcp",
-                &addr,
-                "--calib",
-                seq.join("calib.toml").to_str().unwrap(),
-                "--width",
-                &w.to_string(),
-                "--height",
-                &h.to_string(),
-                "--timeout-ms",
-                "3000",
-                "--out",
-                out_dir.to_str().unwrap(),
-            ])
+            .args(args)
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::piped())
             .spawn()
@@ -359,7 +373,7 @@ fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
         before: 5,
         ..Quirks::default()
     };
-    let (live, _dir, _) = live_on_a_tcp_head(2, true, quirks, &["--json"]);
+    let (live, _setup) = live_on_a_tcp_head(2, true, quirks, &["--json"]);
     assert!(
         live.status.success(),
         "{}",
@@ -376,7 +390,7 @@ fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
         damage: Some(1),
         ..Quirks::default()
     };
-    let (live, dir, _) = live_on_a_tcp_head(3, true, quirks, &[]);
+    let (live, setup) = live_on_a_tcp_head(3, true, quirks, &[]);
     assert!(
         live.status.success(),
         "{}",
@@ -387,7 +401,7 @@ fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
         stderr.contains("frame 1: dropped: ") && stderr.contains("damaged"),
         "{stderr}"
     );
-    let csv = std::fs::read_to_string(dir.path().join("live/verge.csv")).unwrap();
+    let csv = std::fs::read_to_string(setup.out_dir().join("verge.csv")).unwrap();
     let status: Vec<&str> = csv
         .lines()
         .skip(1)
