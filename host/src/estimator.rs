@@ -273,10 +273,12 @@ impl VergeEstimator {
             .zip(&consensus)
             .map(|(c, &inlier)| if inlier { c.weight } else { 0.0 })
             .collect();
-        let linear = constrained::linear_weighted(&corr, &linear_weights).unwrap_or(fallback);
+        // A degenerate linear system leaves the fallback as the only start.
+        let linear = constrained::linear_weighted(&corr, &linear_weights).ok();
         let cfit = lowest_cost(
-            [linear, fallback]
+            linear
                 .into_iter()
+                .chain([fallback])
                 .map(|s| constrained::refine(&corr, s, &self.config.refine)),
             &corr,
             |f| (f.residual_sigma, f.angles.essential()),
