@@ -425,3 +425,30 @@ fn error_reports_outside_a_request_are_kept_bounded_to_the_newest() {
     assert_eq!(reports[63].seq, 99);
     assert!(d.take_device_errors().is_empty());
 }
+
+#[test]
+fn a_register_read_gets_its_error_report_while_unclaimed_reports_fill_the_list() {
+    use stereocal_wire::{ErrorCode, ErrorReportRepr, PacketRepr};
+    let report = |code, detail| PacketRepr::ErrorReport(ErrorReportRepr { code, detail });
+    let mut wire = Wire::new();
+    for detail in 0..64 {
+        wire.push(&report(ErrorCode::Busy, detail));
+    }
+    wire.frame(&FrameSpec::small(1, Camera::Left));
+    // The answer to the read below: the list of unclaimed reports is full when it arrives.
+    wire.push(&report(ErrorCode::UnknownRegister, 0xFC));
+    let mut d = driver(&wire);
+    delivered(d.next_frame(T).unwrap());
+    match d.read_register(0x00FC, T) {
+        Err(DriverError::Device { code, detail, .. }) => {
+            assert_eq!((code, detail), (ErrorCode::UnknownRegister, 0xFC));
+        }
+        other => panic!("the read's error report expected, got {other:?}"),
+    }
+    // The unclaimed reports stay, less the oldest, which the read's own pushed out of the full
+    // list before the read took it.
+    let reports = d.take_device_errors();
+    let details: Vec<u32> = reports.iter().map(|r| r.report.detail).collect();
+    assert_eq!(details, (1..64).collect::<Vec<u32>>());
+    assert!(reports.iter().all(|r| r.report.code == ErrorCode::Busy));
+}

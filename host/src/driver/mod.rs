@@ -129,7 +129,7 @@ pub struct Driver<L: Link> {
     pending_pair: Option<FrameOutcome>,
     hellos: VecDeque<HelloRepr>,
     register_values: VecDeque<(u16, u32)>,
-    device_errors: Vec<DeviceReport>,
+    device_errors: VecDeque<DeviceReport>,
     logs: VecDeque<LogFrame>,
 }
 
@@ -150,7 +150,7 @@ impl<L: Link> Driver<L> {
             pending_pair: None,
             hellos: VecDeque::new(),
             register_values: VecDeque::new(),
-            device_errors: Vec::new(),
+            device_errors: VecDeque::new(),
             logs: VecDeque::new(),
         }
     }
@@ -182,7 +182,7 @@ impl<L: Link> Driver<L> {
 
     /// `ErrorReport`s the device sent outside a request, emptying the list.
     pub fn take_device_errors(&mut self) -> Vec<DeviceReport> {
-        std::mem::take(&mut self.device_errors)
+        self.device_errors.drain(..).collect()
     }
 
     /// Sends the host's `Hello` and waits for the device's (one already received counts).
@@ -220,15 +220,20 @@ impl<L: Link> Driver<L> {
         self.register_values.clear();
         self.send(&PacketRepr::RegisterRead(RegisterReadRepr { addr }))?;
         let deadline = Instant::now() + timeout;
-        let errors_before = self.device_errors.len();
+        // Counted, not indexed: the list drops its oldest reports when full, so an index taken
+        // now could point past a report that arrives during the request.
+        let reported_before = self.assembler.stats.device_errors;
         loop {
             if let Some(i) = self.register_values.iter().position(|&(a, _)| a == addr) {
                 let (_, value) = self.register_values.remove(i).unwrap_or((addr, 0));
                 return Ok(value);
             }
-            if let Some(e) = self.device_errors.get(errors_before) {
-                let e = *e;
-                self.device_errors.truncate(errors_before);
+            let since = (self.assembler.stats.device_errors - reported_before) as usize;
+            // The first report since the request (the oldest kept, had more arrived than the
+            // list holds) answers it; it and the later ones leave the list.
+            let first = self.device_errors.len().saturating_sub(since);
+            if let Some(e) = self.device_errors.get(first).copied() {
+                self.device_errors.truncate(first);
                 return Err(DriverError::Device {
                     code: e.report.code,
                     detail: e.report.detail,
@@ -419,10 +424,10 @@ impl<L: Link> Driver<L> {
                 Event::DeviceError { seq, report } => {
                     // A device that reports on every frame while nobody takes the reports
                     // must not grow the host without bound: the oldest go first.
-                    if self.device_errors.len() == MAX_DEVICE_ERRORS {
-                        self.device_errors.remove(0);
+                    if self.device_errors.len() >= MAX_DEVICE_ERRORS {
+                        self.device_errors.pop_front();
                     }
-                    self.device_errors.push(DeviceReport { seq, report })
+                    self.device_errors.push_back(DeviceReport { seq, report })
                 }
             }
         }
