@@ -52,8 +52,8 @@ PACKAGES = ["numpy", "opencv-python-headless"]
 SCENES = (("terrace", None), ("playground", None), ("playground", (1352, 392)))
 MOTION = "moving"
 RATIO = 0.8
-MIN_POINTS = 5
-RUNS = 3  # whole `stereocal run` commands timed per scene  # fewest ratio-test matches to try E; fewest points in front for a "firm" pose
+MIN_POINTS = 5  # fewest ratio-test matches to try E; fewest points in front for a "firm" pose
+RUNS = 3  # whole `stereocal run` commands timed per scene
 
 
 def in_venv():
