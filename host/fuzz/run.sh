@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every cargo-fuzz target of stereocal (the calibration parser and the image reader) for N seconds each
+# Runs every cargo-fuzz target of stereocal (the calibration parser, the image reader and a whole
+# session on an edited device stream) for N seconds each
 # (default 60): `bash host/fuzz/run.sh [SECONDS]`. See tools/fuzz.sh.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

@@ -127,7 +127,7 @@ pub struct FrameEstimate {
     pub matches: usize,
     /// Matches that entered the estimate (after sub-pixel rejection).
     pub used: usize,
-    /// Matches consistent with the final estimate.
+    /// Point pairs (descriptor and guided matches) consistent with the final estimate.
     pub inliers: usize,
     /// Robust residual scale in pixels (quality of the matches).
     pub residual_px: f64,

@@ -47,7 +47,9 @@ pub struct FrameRecord {
     pub filtered_sigma_deg: Option<f64>,
     /// Matches that passed the ratio test.
     pub matches: usize,
-    /// Matches consistent with the estimated geometry.
+    /// Point pairs consistent with the estimated geometry. They include the guided matches
+    /// (left keypoints without a descriptor match, found by correlation near their
+    /// neighbours' disparity), so `inliers` can exceed `matches`.
     pub inliers: usize,
     /// Left keypoints by octave (index 0 = full resolution), empty unless `status` is `Ok`.
     pub keypoints_per_octave: Vec<usize>,
