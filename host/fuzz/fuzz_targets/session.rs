@@ -43,6 +43,9 @@ struct Reference {
     handshake: Vec<u8>,
     calib: String,
     packets: Vec<Vec<u8>>,
+    /// The raw verge of each pair as the in-process session measured it: the stream replayed
+    /// without edits must give the same, or the harness tests less than it claims.
+    raw_verge_deg: Vec<f64>,
 }
 
 fn calibration(reference: &Reference) -> Calibration {
@@ -71,6 +74,7 @@ fn reference() -> &'static Reference {
         )
         .expect("the in-process device takes the handshake");
         let handshake = session.device_mut().take_received();
+        let mut raw_verge_deg = Vec::new();
         for frame in 0..PAIRS {
             let images = sequence
                 .frame(frame)
@@ -88,6 +92,7 @@ fn reference() -> &'static Reference {
                 .expect("the in-process device answers every pair");
             // The stream must reach the estimator and the filter, or the edits test less.
             assert_eq!(record.status, FrameStatus::Ok, "{record:?}");
+            raw_verge_deg.extend(record.raw_verge_deg);
         }
         let stream = session.device_mut().take_received();
         let packets = stream
@@ -99,6 +104,7 @@ fn reference() -> &'static Reference {
             handshake,
             calib,
             packets,
+            raw_verge_deg,
         }
     })
 }
@@ -183,11 +189,22 @@ fuzz_target!(|data: &[u8]| {
         SessionConfig::default(),
     )
     .expect("the recorded handshake replays");
+    let mut raw_verge_deg = Vec::new();
     for frame in 0..MAX_RECORDS {
         match session.receive(frame) {
-            Ok(record) => check(&record, frame),
+            Ok(record) => {
+                check(&record, frame);
+                raw_verge_deg.push(record.raw_verge_deg);
+            }
             // The end of the replay closes the link; a pair out of step ends the session.
-            Err(_) => return,
+            Err(_) => break,
         }
+    }
+    if edits.len() < EDIT_LEN {
+        let expected: Vec<_> = reference.raw_verge_deg.iter().copied().map(Some).collect();
+        assert_eq!(
+            raw_verge_deg, expected,
+            "the unedited stream replays differently"
+        );
     }
 });
