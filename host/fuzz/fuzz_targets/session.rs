@@ -41,16 +41,11 @@ const MAX_RECORDS: usize = 64;
 /// streaming state), the calibration, and the packets of the pairs after it, unframed.
 struct Reference {
     handshake: Vec<u8>,
-    calib: String,
+    calib: Calibration,
     packets: Vec<Vec<u8>>,
     /// The raw verge of each pair as the in-process session measured it: the stream replayed
     /// without edits must give the same, or the harness tests less than it claims.
     raw_verge_deg: Vec<f64>,
-}
-
-fn calibration(reference: &Reference) -> Calibration {
-    Calibration::from_toml_str(&reference.calib, "the rendered sequence's calib.toml")
-        .expect("the renderer writes a valid calibration")
 }
 
 fn reference() -> &'static Reference {
@@ -63,16 +58,11 @@ fn reference() -> &'static Reference {
             ..SequenceConfig::for_scene(SceneKind::Lab)
         };
         let sequence = Sequence::builtin(SceneKind::Lab, config).expect("the lab scene renders");
-        let calib = sequence.calib_toml();
+        let calib = Calibration::from_toml_str(&sequence.calib_toml(), "calib.toml")
+            .expect("the renderer writes a valid calibration");
         let device = Recording::new(InProcessLink::new().expect("the in-process device opens"));
-        let mut session = Session::with_device(
-            device,
-            Calibration::from_toml_str(&calib, "calib.toml").expect("a valid calibration"),
-            W,
-            H,
-            SessionConfig::default(),
-        )
-        .expect("the in-process device takes the handshake");
+        let mut session = Session::with_device(device, calib, W, H, SessionConfig::default())
+            .expect("the in-process device takes the handshake");
         let handshake = session.device_mut().take_received();
         let mut raw_verge_deg = Vec::new();
         for frame in 0..PAIRS {
@@ -181,14 +171,8 @@ fuzz_target!(|data: &[u8]| {
         _ => ReplayLink::new(stream).with_chunk(usize::from(chunk - 127) * 2),
     };
     let device = OwnCameras::new(link, "fuzz replay", Duration::from_millis(1));
-    let mut session = Session::with_device(
-        device,
-        calibration(reference),
-        W,
-        H,
-        SessionConfig::default(),
-    )
-    .expect("the recorded handshake replays");
+    let mut session = Session::with_device(device, reference.calib, W, H, SessionConfig::default())
+        .expect("the recorded handshake replays");
     let mut raw_verge_deg = Vec::new();
     for frame in 0..MAX_RECORDS {
         match session.receive(frame) {
