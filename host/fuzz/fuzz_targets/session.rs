@@ -26,6 +26,7 @@ use stereocal::link::{InProcessLink, OwnCameras, Recording, ReplayLink};
 use stereocal::record::FrameStatus;
 use stereocal::session::{Session, SessionConfig};
 use stereocal::synth::{SceneKind, Sequence, SequenceConfig};
+use stereocal_wire::DELIMITER;
 
 const W: u16 = 128;
 const H: u16 = 96;
@@ -86,7 +87,7 @@ fn reference() -> &'static Reference {
         }
         let stream = session.device_mut().take_received();
         let packets = stream
-            .split(|&b| b == 0)
+            .split(|&b| b == DELIMITER)
             .filter(|frame| !frame.is_empty())
             .map(|frame| cobs::decode_vec(frame).expect("the device frames with COBS"))
             .collect();
@@ -163,7 +164,7 @@ fuzz_target!(|data: &[u8]| {
     let mut stream = reference.handshake.clone();
     for packet in edited(&reference.packets, edits) {
         stream.extend(cobs::encode_vec(&packet));
-        stream.push(0);
+        stream.push(DELIMITER);
     }
     // Chunks of 2 to 256 bytes, or the default 4096 for half of the inputs' first bytes.
     let link = match chunk {
