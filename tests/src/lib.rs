@@ -9,7 +9,10 @@
 //!   --target riscv32imc-unknown-none-elf` once (a no-op when it is up to date, so the ELF
 //!   never lags behind the in-process model it is compared with) and uses
 //!   `target/riscv32imc-unknown-none-elf/release/stereocal-firmware` (`CARGO_TARGET_DIR` is
-//!   honoured). `STEREOCAL_FIRMWARE_ELF` names another ELF and skips the build.
+//!   honoured). A toolchain without that target gets it from `rustup target add`; where that
+//!   cannot be done (no rustup, no network, a release the registry does not serve the target
+//!   for) the tests that need the ELF skip loudly, and fail under `CI=true`.
+//!   `STEREOCAL_FIRMWARE_ELF` names another ELF and skips the build.
 //!
 //! The comparison ([`assert_same_stream`]): the firmware answers the host's `Hello` with the
 //! `LOG` capability added (it has a defmt logger; the in-process device does not). Every
@@ -239,33 +242,117 @@ pub fn qemu_or_skip(test: &str) -> Option<QemuConfig> {
         );
         return None;
     }
-    Some(QemuConfig::new(firmware_elf()))
+    firmware_elf_or_skip(test).map(QemuConfig::new)
 }
 
-/// The firmware ELF, built once per test binary (see the crate docs).
-pub fn firmware_elf() -> PathBuf {
-    static ELF: OnceLock<PathBuf> = OnceLock::new();
-    ELF.get_or_init(|| {
-        if let Some(elf) = std::env::var_os("STEREOCAL_FIRMWARE_ELF") {
-            return PathBuf::from(elf);
+/// The soft-core's Rust target: the firmware ELF is built for it.
+pub const FIRMWARE_TARGET: &str = "riscv32imc-unknown-none-elf";
+
+/// The firmware ELF, built once per test binary (see the crate docs), or `None` after a loud
+/// `SKIPPED` line naming [`FIRMWARE_TARGET`] when the toolchain lacks that target and
+/// `rustup target add` cannot install it. Under `CI=true` a missing target is a failure. A
+/// target that is present but fails to build the firmware is always a failure.
+pub fn firmware_elf_or_skip(test: &str) -> Option<PathBuf> {
+    static ELF: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    match ELF.get_or_init(build_firmware_elf) {
+        Ok(elf) => Some(elf.clone()),
+        Err(reason) => {
+            skip(test, reason);
+            None
         }
-        let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .parent()
-            .expect("tests/ sits in the workspace");
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-        let status = Command::new(cargo)
+    }
+}
+
+/// `Err` says why the target cannot be had; a failed build of a present target panics.
+fn build_firmware_elf() -> Result<PathBuf, String> {
+    if let Some(elf) = std::env::var_os("STEREOCAL_FIRMWARE_ELF") {
+        return Ok(PathBuf::from(elf));
+    }
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ sits in the workspace");
+    ensure_firmware_target(workspace)?;
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(workspace)
+        .args(["build", "--release", "-p", "stereocal-firmware"])
+        .args(["--target", FIRMWARE_TARGET])
+        .status()
+        .expect("cannot run cargo to build the firmware ELF");
+    assert!(
+        status.success(),
+        "building the firmware ELF for {FIRMWARE_TARGET} failed (the target is installed, \
+         so this is the firmware's own error, printed above)"
+    );
+    Ok(std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace.join("target"))
+        .join(FIRMWARE_TARGET)
+        .join("release/stereocal-firmware"))
+}
+
+/// Makes sure the toolchain that builds the workspace has [`FIRMWARE_TARGET`]'s standard
+/// library, adding it with `rustup target add` when it is missing: rustup installs a
+/// toolchain file's targets by itself only when its auto-install is on, and many machines
+/// turn that off. `Err` names the target, the compiler and what the attempt said.
+fn ensure_firmware_target(workspace: &Path) -> Result<(), String> {
+    let rustc = std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into());
+    let installed = || {
+        Command::new(&rustc)
             .current_dir(workspace)
-            .args(["build", "--release", "-p", "stereocal-firmware"])
-            .args(["--target", "riscv32imc-unknown-none-elf"])
-            .status()
-            .expect("cannot run cargo to build the firmware ELF");
-        assert!(status.success(), "building the firmware ELF failed");
-        std::env::var_os("CARGO_TARGET_DIR")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| workspace.join("target"))
-            .join("riscv32imc-unknown-none-elf/release/stereocal-firmware")
-    })
-    .clone()
+            .args(["--print", "target-libdir", "--target", FIRMWARE_TARGET])
+            .output()
+            .ok()
+            .filter(|out| out.status.success())
+            .map(|out| PathBuf::from(String::from_utf8_lossy(&out.stdout).trim()))
+            .and_then(|libdir| std::fs::read_dir(libdir).ok())
+            .is_some_and(|mut entries| {
+                entries.any(|e| {
+                    e.is_ok_and(|e| e.file_name().to_string_lossy().starts_with("libcore-"))
+                })
+            })
+    };
+    if installed() {
+        return Ok(());
+    }
+    let version = Command::new(&rustc)
+        .arg("--version")
+        .output()
+        .map(|out| String::from_utf8_lossy(&out.stdout).trim().to_string())
+        .unwrap_or_else(|e| format!("rustc ({e})"));
+    eprintln!("{FIRMWARE_TARGET} is missing from {version}: running `rustup target add {FIRMWARE_TARGET}`");
+    let added = Command::new("rustup")
+        .current_dir(workspace)
+        .args(["target", "add", FIRMWARE_TARGET])
+        .output();
+    let why = match added {
+        Ok(out) if out.status.success() && installed() => return Ok(()),
+        Ok(out) => format!(
+            "`rustup target add {FIRMWARE_TARGET}` failed ({})",
+            rustup_error(&String::from_utf8_lossy(&out.stderr))
+        ),
+        Err(e) => format!("rustup is not available to add it ({e})"),
+    };
+    Err(format!(
+        "the Rust target {FIRMWARE_TARGET} is not installed for {version} and {why}; \
+         install it with `rustup target add {FIRMWARE_TARGET}`, or name a prebuilt ELF in \
+         STEREOCAL_FIRMWARE_ELF"
+    ))
+}
+
+/// rustup's `error:` lines, without the backtrace it may append; all of its output when it
+/// has none.
+fn rustup_error(stderr: &str) -> String {
+    let errors: Vec<&str> = stderr
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("error"))
+        .collect();
+    if errors.is_empty() {
+        stderr.trim().to_string()
+    } else {
+        errors.join("; ")
+    }
 }
 
 /// `../shared/data/real` (or `STEREOCAL_REAL_DATA`), or `None` after a loud `SKIPPED` line
