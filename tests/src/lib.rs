@@ -320,7 +320,15 @@ fn ensure_firmware_target(workspace: &Path) -> Result<(), String> {
         .output()
         .map(|out| String::from_utf8_lossy(&out.stdout).trim().to_string())
         .unwrap_or_else(|e| format!("rustc ({e})"));
-    eprintln!("{FIRMWARE_TARGET} is missing from {version}: running `rustup target add {FIRMWARE_TARGET}`");
+    {
+        use std::io::Write;
+        // Past the harness's capture, like `skip`: a download is worth a line. A closed
+        // stderr has nobody to tell.
+        let _ = writeln!(
+            std::io::stderr(),
+            "{FIRMWARE_TARGET} is missing from {version}: running `rustup target add {FIRMWARE_TARGET}`"
+        );
+    }
     let added = Command::new("rustup")
         .current_dir(workspace)
         .args(["target", "add", FIRMWARE_TARGET])
