@@ -9,8 +9,9 @@
 //! `stereocal run`, wire included). The rectification leaves a constant residual angle, so
 //! errors are reported after removing the median error of each scene.
 //!
-//! Needs `../shared/data/real` (or `STEREOCAL_REAL_DATA`); skips loudly when absent, and fails
-//! instead under `CI=true`. Run in release: `cargo test --release -p stereocal --test
+//! Needs `../shared/data/real` (or `STEREOCAL_REAL_DATA`), whose `geometry.json` files give each
+//! data set's intrinsics and stereo pose (`docs/ARCHITECTURE.md`, "Real data"); skips loudly
+//! when absent, and fails instead under `CI=true`. Run in release: `cargo test --release -p stereocal --test
 //! estimate_real -- --nocapture`.
 
 use std::path::PathBuf;

@@ -1,4 +1,4 @@
-//! The `stereocal` command line (the contract is in the architecture document).
+//! The `stereocal` command line (its contract: `docs/ARCHITECTURE.md`, "The command line").
 
 mod experiment;
 mod hil;

@@ -8,7 +8,8 @@ use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
 
 use super::{mad_sigma, Correspondence, EssentialError, RefineConfig};
 
-/// The two camera yaws of a verging head, in radians (ARCHITECTURE.md signs).
+/// The two camera yaws of a verging head, in radians (signs: `docs/ARCHITECTURE.md`, "Frames
+/// and signs").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VergeAngles {
     /// Yaw of the left camera; positive turns it toward the right camera.

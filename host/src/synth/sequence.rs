@@ -1,6 +1,6 @@
 //! Stereo sequences: a scene, a head trajectory and camera settings, rendered lazily frame by
 //! frame, with the ground truth of every frame, and written to disk in the formats of
-//! ARCHITECTURE.md (image directories, `calib.toml`, `truth.csv`).
+//! `docs/ARCHITECTURE.md`, "Files" (image directories, `calib.toml`, `truth.csv`).
 
 use std::fmt::Write as _;
 use std::fs;
@@ -431,7 +431,8 @@ impl Sequence {
         }
     }
 
-    /// The calibration file (ARCHITECTURE.md format) of the delivered images.
+    /// The calibration file (`docs/ARCHITECTURE.md`, "Calibration (TOML)") of the delivered
+    /// images.
     pub fn calib_toml(&self) -> String {
         let [l, r] = self.intrinsics();
         let c = &self.config;
