@@ -65,24 +65,43 @@ fn remove_staged(path: &Path) {
     }
 }
 
-/// A staging directory, in the registry for as long as it exists.
-struct Staging {
+/// A hidden directory that is filled and then moved into place whole (`synth` writes a whole
+/// sequence so), in the registry for as long as it exists; dropped, it is removed.
+pub struct StagingDir {
     path: PathBuf,
 }
 
-impl Staging {
-    fn new(dest: &Path) -> std::io::Result<Self> {
+impl StagingDir {
+    /// Creates a fresh staging directory inside `parent`.
+    pub fn new_in(parent: &Path) -> std::io::Result<Self> {
         let mut staged = staged();
         let path = tempfile::Builder::new()
             .prefix(STAGING_PREFIX)
-            .tempdir_in(dest)?
+            .tempdir_in(parent)?
             .keep();
         staged.push(path.clone());
-        Ok(Staging { path })
+        Ok(StagingDir { path })
+    }
+
+    /// Where to write.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames the directory to `dest`, which must not exist or be an empty directory (it is
+    /// replaced). An interruption waits for the rename, so `dest` is whole or absent.
+    pub fn persist(self, dest: &Path) -> std::io::Result<()> {
+        let mut staged = staged();
+        if dest.exists() {
+            std::fs::remove_dir(dest)?;
+        }
+        std::fs::rename(&self.path, dest)?;
+        staged.retain(|p| *p != self.path);
+        Ok(())
     }
 }
 
-impl Drop for Staging {
+impl Drop for StagingDir {
     fn drop(&mut self) {
         let mut staged = staged();
         // Nothing to report from a destructor: a directory that cannot be removed stays.
@@ -94,7 +113,7 @@ impl Drop for Staging {
 /// Files being staged for one output directory.
 pub struct StagedOutput {
     dest: PathBuf,
-    staging: Staging,
+    staging: StagingDir,
     names: Vec<String>,
 }
 
@@ -106,7 +125,7 @@ impl StagedOutput {
             action: "cannot create output directory",
             source,
         })?;
-        let staging = Staging::new(dest).map_err(|source| OutputError {
+        let staging = StagingDir::new_in(dest).map_err(|source| OutputError {
             path: dest.to_owned(),
             action: "cannot create a staging directory",
             source,

@@ -1,6 +1,7 @@
 //! Ctrl-C during `stereocal run`'s final write leaves nothing behind: no staging directory,
 //! and in `--out` either the previous `verge.csv` and `verge.png` or the new ones, never one of
-//! each.
+//! each. Ctrl-C while `stereocal synth` writes a sequence leaves neither its staging directory
+//! nor a part of the sequence.
 //!
 //! The test watches the output directory and sends SIGINT once the run's staging directory
 //! appears, after a delay that grows from trial to trial, so that the signals land while the
@@ -60,6 +61,13 @@ struct Trial {
     old_kept: bool,
 }
 
+/// Sends SIGINT to `child`.
+fn interrupt(child: &std::process::Child) {
+    let pid = libc::pid_t::try_from(child.id()).unwrap();
+    // SAFETY: `kill` only sends a signal; the child is ours and not yet reaped.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGINT) }, 0);
+}
+
 fn trial(root: &Path, out: &Path, delay: Duration) -> Trial {
     std::fs::create_dir_all(out).unwrap();
     std::fs::write(out.join("verge.csv"), OLD_CSV).unwrap();
@@ -90,9 +98,7 @@ fn trial(root: &Path, out: &Path, delay: Duration) -> Trial {
             while seen.elapsed() < delay {
                 std::hint::spin_loop();
             }
-            let pid = libc::pid_t::try_from(child.id()).unwrap();
-            // SAFETY: `kill` only sends a signal; the child is ours and not yet reaped.
-            assert_eq!(unsafe { libc::kill(pid, libc::SIGINT) }, 0);
+            interrupt(&child);
             signalled = true;
         }
         assert!(
@@ -168,5 +174,38 @@ fn ctrl_c_during_the_final_write_leaves_the_old_output_or_the_new_and_no_staging
     assert!(
         interrupted > 0,
         "no SIGINT landed during the final write: the test exercised nothing"
+    );
+}
+
+#[test]
+fn ctrl_c_while_synth_writes_leaves_no_staging_and_no_part_of_the_sequence() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("sequence");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_stereocal"))
+        .args([
+            "synth", "--scene", "road", "--frames", "8", "--seed", "1", "--out",
+        ])
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("stereocal runs");
+    let started = Instant::now();
+    while staging_entries(root.path()).is_empty() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "synth ended before its staging directory was seen"
+        );
+        assert!(started.elapsed() < Duration::from_secs(60), "no staging");
+    }
+    interrupt(&child);
+    let status = child.wait().unwrap();
+    let left = staging_entries(root.path());
+    assert!(left.is_empty(), "left behind: {left:?}");
+    assert_eq!(status.code(), Some(130), "{status}");
+    assert!(
+        !out.exists(),
+        "a part of the sequence was left in {}",
+        out.display()
     );
 }
