@@ -1,4 +1,4 @@
-//! The thesis' constrained model: both cameras only yaw, E = [[0,e1,0],[e2,0,e4],[0,e3,0]].
+//! The thesis' constrained model: both cameras only yaw, `E = [[0,e1,0],[e2,0,e4],[0,e3,0]]`.
 //!
 //! Pipeline: a linear least-squares solve of the four unknowns (null vector by SVD), the
 //! rank-2 / equal-singular-value projection, the sign (180°) ambiguity resolved from U, then a
