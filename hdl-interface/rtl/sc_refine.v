@@ -11,7 +11,7 @@
 // Why 18: the single-clock version was 144.7 ns of logic (yosys `sta`, iCE40 HX cells), the
 // one path keeping the octave below 9.73 MHz (640x240 at 60 Hz). Each stage above is one
 // product level or one of the 15 dependent 59-bit compare/subtract steps of the restoring
-// divider (about 8 ns each), aiming at the convolvers' depth (~10 ns). Longest stage now
+// divider (about 8 ns each), aiming at the convolvers' depth (~10 ns). Longest stage
 // (yosys `sta` after `synth_ice40 -top sc_refine`, iCE40 HX cell delays, logic only): 13.7 ns,
 // stage 3 (det: a 20x39-bit product and the 3-term sum; stage 4 is about as long, the divider
 // stages about 9.5 ns), <= 72.9 MHz before routing; 3 divider steps per stage gave 29.6 ns.

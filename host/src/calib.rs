@@ -1,6 +1,6 @@
 //! The stereo head's calibration file (TOML) and the pixel ↔ calibrated-coordinate maps.
 //!
-//! Format (ARCHITECTURE.md): top-level `baseline_m`, and `[left]` / `[right]` tables with
+//! Format (`docs/ARCHITECTURE.md`, "Calibration (TOML)"): top-level `baseline_m`, and `[left]` / `[right]` tables with
 //! `fx, fy, cx, cy` in pixels. **Extension:** each camera table may also carry the OpenCV
 //! radial-tangential distortion `k1, k2, p1, p2` (all default to 0), which raw (unrectified)
 //! cameras such as EuRoC need. Any other key is an error that names it.

@@ -463,7 +463,7 @@ mod tests {
         }
     }
 
-    /// The per-sample scatter that [`accumulate_fixed`] replaced: for each sample, its up to
+    /// The per-sample scatter that [`accumulate_fixed`] must equal: for each sample, its up to
     /// four cells (weights `g · wx · wy`, in (dy, dx) order) each get `m · w · (1 − fo)` at
     /// bin `b0` and `m · w · fo` at `b1`.
     fn scatter_reference(window: &[(u8, u8)], mode: DescriptorMode, hist: &mut [f32]) {

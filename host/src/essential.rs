@@ -1,6 +1,6 @@
 //! Essential-matrix estimation for a verging stereo head.
 //!
-//! Geometry (ARCHITECTURE.md conventions, derived here once): the head frame is the left
+//! Geometry (`docs/ARCHITECTURE.md`, "Frames and signs", derived here once): the head frame is the left
 //! camera's frame at zero yaw; x right, y down, z forward; the right camera's centre is at
 //! t = (b, 0, 0). A camera with yaw `alpha` about its own (downward) y axis has orientation
 //! `Ry(alpha) = [[c, 0, s], [0, 1, 0], [-s, 0, c]]` (columns = camera axes in the head frame),
@@ -18,8 +18,8 @@
 //! `e1 = -sin a_r, e2 = sin a_l, e3 = cos a_r, e4 = -cos a_l`. The verge angle is
 //! `a_l - a_r` (toe-in positive). For the general model the relative rotation
 //! `R = Ry(a_r)ᵀ Ry(a_l)` maps left to right camera coordinates and `E = [t_r]ₓ R` with
-//! `t_r = Ry(a_r)ᵀ t`; `R_01 = Rᵀ = Ry(yaw) Rx(pitch) Rz(roll)` as in the data sets'
-//! geometry.json, so `verge = -yaw`.
+//! `t_r = Ry(a_r)ᵀ t`; `R_01 = Rᵀ = Ry(yaw) Rx(pitch) Rz(roll)` as in the real data sets'
+//! `geometry.json` (`docs/ARCHITECTURE.md`, "Real data"), so `verge = -yaw`.
 
 pub mod constrained;
 pub mod general;

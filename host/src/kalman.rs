@@ -16,8 +16,7 @@
 //! it follows any error that persists for a few frames. On real frames the per-frame error is
 //! such a slowly changing function of the view (a head on a moving vehicle sees the scene
 //! drift); holding the rate at zero averages it over as many frames as the drift density
-//! allows (on the injected-verge terrace sequence the fixed-camera span fell from 0.067° to
-//! under 0.03°).
+//! allows.
 //!
 //! Why the models are weighed by a Student-t likelihood rather than a Gaussian: the per-frame
 //! errors have heavier tails than the estimator's σ says (a 3-4 σ frame every few dozen), and

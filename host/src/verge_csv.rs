@@ -1,5 +1,5 @@
 //! The per-frame output CSV (`verge.csv`) and the ground-truth CSV (`frame,verge_deg`), in the
-//! formats of the architecture's conventions.
+//! formats of `docs/ARCHITECTURE.md` ("`verge.csv`", "Truth CSV").
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

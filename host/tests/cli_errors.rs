@@ -1,6 +1,6 @@
 //! The `stereocal run` binary against bad input, end to end.
 //!
-//! The CLI contract (ARCHITECTURE.md) promises that every bad call ends with a message naming
+//! The CLI contract (`docs/ARCHITECTURE.md`, "The command line") promises that every bad call ends with a message naming
 //! the file, field, key or flag at fault, a non-zero exit, and nothing half-written. Unit tests
 //! check the error values of each module; these tests check what a user actually sees: the
 //! exit status, stderr (the named culprit, and never a panic) and the `--out` directory (no

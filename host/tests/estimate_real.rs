@@ -4,12 +4,14 @@
 //! Each ETH3D two-view pair (rectified) is turned into a sequence: frame `i` warps the left
 //! image by `alpha_l(i)` and the right one by `alpha_r(i)` (pure-rotation homographies,
 //! `stereocal::synth::inject`), runs the fabric's fast path on both images, converts its
-//! output to `FeatureFrame`s (a small adaptor until the wire path exists) and estimates.
-//! The rectification leaves a constant residual angle, so errors are reported after
-//! removing the median error of each scene.
+//! output to `FeatureFrame`s directly and estimates: this test measures the estimator, not
+//! the wire (`bash bench/injected_real.sh` runs the same kind of sequences through
+//! `stereocal run`, wire included). The rectification leaves a constant residual angle, so
+//! errors are reported after removing the median error of each scene.
 //!
-//! Needs `../shared/data/real` (or `STEREOCAL_REAL_DATA`); skips loudly when absent, and fails
-//! instead under `CI=true`. Run in release: `cargo test --release -p stereocal --test
+//! Needs `../shared/data/real` (or `STEREOCAL_REAL_DATA`), whose `geometry.json` files give each
+//! data set's intrinsics and stereo pose (`docs/ARCHITECTURE.md`, "Real data"); skips loudly
+//! when absent, and fails instead under `CI=true`. Run in release: `cargo test --release -p stereocal --test
 //! estimate_real -- --nocapture`.
 
 use std::path::PathBuf;

@@ -1,7 +1,7 @@
 //! The ground-truth targets, end to end (renderer → fabric model → wire → host → Kalman): on
 //! `road`, median |raw error| ≤ 0.01°, filtered max ≤ 0.05° and ≥ 95 % of frames estimated;
-//! on `sparse`, no estimate rather than a wrong number. Short sequences keep the test quick;
-//! `stereocal eval --scene road --frames 200 --seed S --json` checks the long form.
+//! on `sparse`, `no_estimate` on every frame rather than a number. Short sequences keep the
+//! test quick; `stereocal eval --scene road --frames 200 --seed S --json` checks the long form.
 
 use stereocal::eval::evaluate;
 use stereocal::record::FrameStatus;
@@ -49,24 +49,23 @@ fn moving_verge_is_tracked() {
 }
 
 #[test]
-fn sparse_scene_gives_no_estimate_rather_than_a_wrong_number() {
-    let config = SequenceConfig {
-        frames: 8,
-        seed: 2,
-        ..SequenceConfig::for_scene(SceneKind::Sparse)
-    };
-    let sequence = Sequence::builtin(SceneKind::Sparse, config).expect("sequence");
-    let (records, _) =
-        evaluate(&sequence, SessionConfig::default(), &mut |_| {}).expect("evaluation");
-    for r in &records {
-        match r.status {
-            FrameStatus::NoEstimate => assert_eq!(r.raw_verge_deg, None),
-            // A frame that did estimate must still be right.
-            FrameStatus::Ok => {
-                let err = (r.raw_verge_deg.unwrap() - r.truth_deg.unwrap()).abs();
-                assert!(err <= 0.05, "frame {}: error {err}°", r.frame);
-            }
-            FrameStatus::Dropped => panic!("frame {} dropped without a drop rate", r.frame),
+fn sparse_scene_gives_no_estimate_on_every_frame() {
+    for seed in 1..=3 {
+        let config = SequenceConfig {
+            frames: 8,
+            seed,
+            ..SequenceConfig::for_scene(SceneKind::Sparse)
+        };
+        let sequence = Sequence::builtin(SceneKind::Sparse, config).expect("sequence");
+        let (records, _) =
+            evaluate(&sequence, SessionConfig::default(), &mut |_| {}).expect("evaluation");
+        for r in &records {
+            assert_eq!(
+                (r.status, r.raw_verge_deg),
+                (FrameStatus::NoEstimate, None),
+                "seed {seed}, frame {}",
+                r.frame
+            );
         }
     }
 }

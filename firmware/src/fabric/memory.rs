@@ -7,10 +7,15 @@
 use crate::fabric::convolver::ROW_BITS;
 use crate::fabric::output::POINT_FIFO_CAPACITY;
 
-/// Bits of one Sobel FIFO entry: octave 2 + orientation 6 + magnitude 8 + x 11 + y 11.
-pub const SOBEL_ENTRY_BITS: usize = 38;
-/// Bits of one point FIFO entry: x 11 + y 11 + octave 2 + scale 2 + 3 × 16 offsets + 16 DoG.
-pub const POINT_ENTRY_BITS: usize = 90;
+/// Bits of one entry of each output FIFO. The RTL declares them (the `DW` of `sc_fabric`'s
+/// two `sc_out_fifo` instances: a point is octave 2 + DoG, ds, dy, dx 4 × 16 + y 11 + x 11 =
+/// 88, a Sobel pixel octave 2 + orientation 6 + magnitude 8 + y 16 + x 16 = 48), and
+/// `tests/memory.rs` reads them from there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FifoEntryBits {
+    pub point: usize,
+    pub sobel: usize,
+}
 
 /// Line and alignment memory bits of octave `k` of width `w`, as the RTL (`sc_octave`) sizes
 /// them: its convolvers (four in octave 0, three beyond: G0 is the input there) with four
@@ -24,8 +29,9 @@ pub const fn octave_ram_bits(w: usize, k: usize) -> usize {
 }
 
 /// Block RAM bits of the whole front end for a `width`-pixel input and `octaves` octaves,
-/// including the output FIFOs (Sobel `3·width` entries, point [`POINT_FIFO_CAPACITY`]).
-pub const fn front_end_ram_bits(width: usize, octaves: usize) -> usize {
+/// including the output FIFOs (Sobel `3·width` entries, point [`POINT_FIFO_CAPACITY`]) with
+/// entries of `entry` bits.
+pub const fn front_end_ram_bits(width: usize, octaves: usize, entry: FifoEntryBits) -> usize {
     let mut bits = 0;
     let mut w = width;
     let mut k = 0;
@@ -34,5 +40,5 @@ pub const fn front_end_ram_bits(width: usize, octaves: usize) -> usize {
         w = w.div_ceil(2);
         k += 1;
     }
-    bits + 3 * width * SOBEL_ENTRY_BITS + POINT_FIFO_CAPACITY * POINT_ENTRY_BITS
+    bits + 3 * width * entry.sobel + POINT_FIFO_CAPACITY * entry.point
 }

@@ -28,7 +28,7 @@ use fixed::types::I3F13;
 /// 144.7 ns of logic with iCE40 HX cell delays (≤ 6.9 MHz), the one path keeping the fabric
 /// below the 9.73 MHz that 640x240 at 60 Hz needs; split so that no stage holds more than one
 /// level of products or one of the fifteen dependent 59-bit compare/subtract steps of the
-/// restoring divider (about 8 ns each), near the convolvers' depth. The longest stage is now
+/// restoring divider (about 8 ns each), near the convolvers' depth. The longest stage is
 /// 13.7 ns of logic (yosys `sta`, same cells; stage 3), ≤ 72.9 MHz before routing.
 pub const REFINE_LATENCY: u32 = 18;
 

@@ -1,4 +1,4 @@
-//! The `stereocal` command line (the contract is in the architecture document).
+//! The `stereocal` command line (its contract: `docs/ARCHITECTURE.md`, "The command line").
 
 mod experiment;
 mod hil;
@@ -10,7 +10,9 @@ mod real;
 mod reliability;
 mod synthetic;
 
+use anyhow::Context;
 use clap::{Parser, Subcommand};
+use stereocal::output_dir::remove_staged_on_interrupt;
 
 /// Online verge-angle calibration of an active stereo head.
 #[derive(Debug, Parser)]
@@ -44,6 +46,11 @@ enum Command {
 
 impl Cli {
     pub fn run(&self) -> anyhow::Result<()> {
+        // `live` stops at Ctrl-C and writes what it received; every other command ends there,
+        // taking its staged files with it.
+        if !matches!(self.command, Command::Live(_)) {
+            remove_staged_on_interrupt().context("cannot install the Ctrl-C handler")?;
+        }
         match &self.command {
             Command::Demo(a) => synthetic::demo(a),
             Command::Run(a) => real::run(a),

@@ -1,4 +1,4 @@
-//! The thesis' constrained model: both cameras only yaw, E = [[0,e1,0],[e2,0,e4],[0,e3,0]].
+//! The thesis' constrained model: both cameras only yaw, `E = [[0,e1,0],[e2,0,e4],[0,e3,0]]`.
 //!
 //! Pipeline: a linear least-squares solve of the four unknowns (null vector by SVD), the
 //! rank-2 / equal-singular-value projection, the sign (180°) ambiguity resolved from U, then a
@@ -8,7 +8,8 @@ use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
 
 use super::{mad_sigma, Correspondence, EssentialError, RefineConfig};
 
-/// The two camera yaws of a verging head, in radians (ARCHITECTURE.md signs).
+/// The two camera yaws of a verging head, in radians (signs: `docs/ARCHITECTURE.md`, "Frames
+/// and signs").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VergeAngles {
     /// Yaw of the left camera; positive turns it toward the right camera.

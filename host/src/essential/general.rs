@@ -21,7 +21,8 @@ pub struct RelativePose {
 }
 
 /// Yaw, pitch and roll (radians) of `R_01 = Ry(yaw) Rx(pitch) Rz(roll)`, the orientation of
-/// the right camera in the left camera's frame (the data sets' geometry.json convention).
+/// the right camera in the left camera's frame (the convention of the real data sets'
+/// `geometry.json`: `docs/ARCHITECTURE.md`, "Real data").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawPitchRoll {
     pub yaw: f64,

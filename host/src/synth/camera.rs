@@ -1,6 +1,6 @@
 //! The pinhole cameras of the synthetic head and their exact projection.
 //!
-//! Conventions (ARCHITECTURE.md): camera frame x right, y down, z forward; pixel coordinates
+//! Conventions (`docs/ARCHITECTURE.md`, "Frames and signs"): camera frame x right, y down, z forward; pixel coordinates
 //! `u = fx * x / z + cx`, `v = fy * y / z + cy`, with integer coordinates at pixel *centres*
 //! (pixel `i` covers `[i - 0.5, i + 0.5]`). The renderer casts its rays through exactly this
 //! model, so projecting a scene point with [`CameraPose::project`] is the ground truth of where

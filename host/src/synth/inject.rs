@@ -1,12 +1,13 @@
 //! Exact verge injection into a real (rectified) stereo pair.
 //!
 //! Turning a camera about its optical centre changes its image by a homography, independent
-//! of the scene: a camera whose orientation becomes `Ry(alpha)` (ARCHITECTURE.md sign:
-//! `alpha > 0` turns the optical axis toward +x) sees the head-frame ray `X` at
-//! `x' ~ K Ry(alpha)ᵀ X`, where the unturned camera saw `x ~ K X`. So the new image is
-//! `I'(x') = I(H⁻¹ x')` with `H = K Ry(alpha)ᵀ K⁻¹` — exactly geometry.json's
-//! `verge_injection` note (`warpPerspective(img, K Ry(θ)ᵀ K⁻¹)` gives yaw = +θ). Applying
-//! `alpha_l` to the left and `alpha_r` to the right image of a rectified pair yields a pair with
+//! of the scene: a camera whose orientation becomes `Ry(alpha)` (signs as in
+//! `docs/ARCHITECTURE.md`, "Frames and signs": `alpha > 0` turns the optical axis toward +x)
+//! sees the head-frame ray `X` at `x' ~ K Ry(alpha)ᵀ X`, where the unturned camera saw
+//! `x ~ K X`. So the new image is `I'(x') = I(H⁻¹ x')` with `H = K Ry(alpha)ᵀ K⁻¹` — exactly
+//! the `verge_injection` note of the real data sets' `geometry.json` ("Real data" in the same
+//! document: `warpPerspective(img, K Ry(θ)ᵀ K⁻¹)` gives yaw = +θ). Applying `alpha_l` to the
+//! left and `alpha_r` to the right image of a rectified pair yields a pair with
 //! verge `alpha_l - alpha_r` plus whatever residual the rectification left.
 //!
 //! Resampling is bicubic (Keys, a = -0.5): it reproduces quadratics and does not smooth the

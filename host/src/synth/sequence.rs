@@ -1,10 +1,10 @@
 //! Stereo sequences: a scene, a head trajectory and camera settings, rendered lazily frame by
 //! frame, with the ground truth of every frame, and written to disk in the formats of
-//! ARCHITECTURE.md (image directories, `calib.toml`, `truth.csv`).
+//! `docs/ARCHITECTURE.md`, "Files" (image directories, `calib.toml`, `truth.csv`).
 
 use std::fmt::Write as _;
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use image::GrayImage;
 use nalgebra::Vector3;
@@ -17,6 +17,7 @@ use super::render::{render, MotionBlur, RenderSpec, RowMap, Supersampling};
 use super::scene::{Scene, SceneKind};
 use super::trajectory::{HeadState, Trajectory, TrajectoryKind};
 use super::SynthError;
+use crate::output_dir::StagingDir;
 
 /// Distance between the optical centres (thesis head: 0.3 m), right camera at +x.
 pub const BASELINE_M: f64 = 0.3;
@@ -431,7 +432,8 @@ impl Sequence {
         }
     }
 
-    /// The calibration file (ARCHITECTURE.md format) of the delivered images.
+    /// The calibration file (`docs/ARCHITECTURE.md`, "Calibration (TOML)") of the delivered
+    /// images.
     pub fn calib_toml(&self) -> String {
         let [l, r] = self.intrinsics();
         let c = &self.config;
@@ -496,7 +498,8 @@ impl Sequence {
     /// Write `left/NNNNNN.png`, `right/NNNNNN.png` (8-bit grey; no files for dropped frames,
     /// so the numbering shows the gap), `calib.toml`, `truth.csv` and `frames.csv` into `dir`.
     /// `dir` must not exist or be empty; everything is written to a sibling staging directory
-    /// that is renamed into place at the end, so a failure leaves nothing half-written.
+    /// that is renamed into place at the end, so a failure or Ctrl-C leaves nothing
+    /// half-written.
     pub fn write_sequence(&self, dir: &Path) -> Result<(), SynthError> {
         self.write_sequence_with(dir, &|_| {})
     }
@@ -518,21 +521,15 @@ impl Sequence {
                 return Err(SynthError::OutputNotEmpty(dir.to_path_buf()));
             }
         }
-        let staging = staging_dir(dir);
-        if staging.exists() {
-            fs::remove_dir_all(&staging).map_err(io(&staging))?;
-        }
-        let result = self.write_into(&staging, progress).and_then(|()| {
-            if dir.exists() {
-                fs::remove_dir(dir).map_err(io(dir))?;
-            }
-            fs::rename(&staging, dir).map_err(io(dir))
-        });
-        if result.is_err() {
-            // Best effort: the error being reported is the interesting one.
-            let _ = fs::remove_dir_all(&staging);
-        }
-        result
+        let parent = dir
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        fs::create_dir_all(parent).map_err(io(parent))?;
+        // Removed when dropped: on an error here, and by Ctrl-C's handler.
+        let staging = StagingDir::new_in(parent).map_err(io(parent))?;
+        self.write_into(staging.path(), progress)?;
+        staging.persist(dir).map_err(io(dir))
     }
 
     fn write_into(&self, dir: &Path, progress: &(dyn Fn(usize) + Sync)) -> Result<(), SynthError> {
@@ -570,13 +567,6 @@ impl Sequence {
 }
 
 /// The hidden sibling `dir` is assembled in.
-fn staging_dir(dir: &Path) -> PathBuf {
-    let name = dir
-        .file_name()
-        .map_or_else(|| "synth".into(), |n| n.to_string_lossy().into_owned());
-    dir.with_file_name(format!(".{name}.partial-{}", std::process::id()))
-}
-
 /// Lazily rendering iterator over a [`Sequence`].
 #[derive(Debug, Clone)]
 pub struct Frames<'a> {
