@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use clap::{Args, ValueEnum};
+use clap::{ArgGroup, Args, ValueEnum};
 use image::GrayImage;
 use stereocal::calib::Calibration;
 use stereocal::sequence::{load_gray, SizeLimits, StereoSequence};
@@ -28,9 +28,10 @@ pub enum MotionArg {
 }
 
 #[derive(Debug, Clone, Args)]
+#[command(group(ArgGroup::new("input").required(true).args(["left_image", "left"])))]
 pub struct InjectArgs {
     /// Left image of a rectified pair (with --right-image; or give a sequence with --left/--right).
-    #[arg(long, requires = "right_image", required_unless_present = "left")]
+    #[arg(long, requires = "right_image")]
     left_image: Option<PathBuf>,
     /// Right image of the pair.
     #[arg(long, requires = "left_image")]
