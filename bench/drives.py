@@ -7,8 +7,9 @@ is `kitti_odometry_drive` alone. The others are left out, and the script says so
 sequence (`cam0/`, `cam1/`) is raw, distorted and not rectified, with a 0.8 deg pitch between
 its cameras, so the pure-rotation homography K Ry(a)^T K^-1 is not what turning its cameras does
 to its pixels (the lens distortion moves with the sensor, not with the ray) and its verge is
-not the only misalignment a verge-only fit must explain; the ETH3D, EuRoC-pairs and
-Middlebury folders hold single or unrelated pairs, not sequences.
+not the only misalignment a verge-only fit must explain; the ETH3D and EuRoC-pairs folders
+hold single or unrelated pairs, not sequences, and the Middlebury ring views are not rectified
+(23 deg toe-in with 3.2 deg roll, an object on black).
 
 For each sequence the untouched frames run first, then `stereocal inject --left --right` makes
 one injected sequence per trajectory (`moving`: verge about +-3 deg, cameras on their own
