@@ -1,4 +1,4 @@
-//! The `stereocal run` binary against bad input, end to end.
+//! The `stereocal run` binary (and `stereocal inject` on a sequence) against bad input, end to end.
 //!
 //! The CLI contract (`docs/ARCHITECTURE.md`, "The command line") promises that every bad call ends with a message naming
 //! the file, field, key or flag at fault, a non-zero exit, and nothing half-written. Unit tests
@@ -320,4 +320,71 @@ fn textureless_sequence_gives_no_estimate_rows() {
         assert_eq!(row[6], "no_estimate", "{csv}");
     }
     assert!(f.out().join("verge.png").is_file(), "verge.png written");
+}
+
+impl Fixture {
+    /// `stereocal inject` on the fixture's directories as a sequence, writing to `--out`.
+    fn inject(&self, extra: &[&str]) -> Output {
+        Command::new(env!("CARGO_BIN_EXE_stereocal"))
+            .env_remove("RUST_BACKTRACE")
+            .env_remove("RUST_LIB_BACKTRACE")
+            .arg("inject")
+            .arg("--left")
+            .arg(self.left())
+            .arg("--right")
+            .arg(self.right())
+            .arg("--calib")
+            .arg(self.calib())
+            .arg("--out")
+            .arg(self.out())
+            .args(extra)
+            .output()
+            .expect("the stereocal binary runs")
+    }
+}
+
+#[test]
+fn inject_into_a_sequence_writes_every_frame_and_its_truth() {
+    let f = Fixture::with_frames(2);
+    let output = f.inject(&["--motion", "swing"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for side in ["left", "right"] {
+        let n = std::fs::read_dir(f.out().join(side)).expect("list").count();
+        assert_eq!(n, 2, "{side}");
+    }
+    let truth = std::fs::read_to_string(f.out().join("truth.csv")).expect("truth");
+    assert_eq!(truth.lines().count(), 3, "{truth}");
+    assert!(truth.starts_with("frame,verge_deg\n0,0.0"), "{truth}");
+}
+
+#[test]
+fn inject_refuses_bad_sequences_and_flag_mixes() {
+    let f = Fixture::with_frames(2);
+    let fails = |extra: &[&str], needle: &str| {
+        let output = f.inject(extra);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && !stderr.contains("panicked"),
+            "{stderr}"
+        );
+        assert!(
+            stderr.contains(needle),
+            "stderr does not name `{needle}`:\n{stderr}"
+        );
+        assert!(
+            !f.out().exists(),
+            "a failed inject wrote {}",
+            display(&f.out())
+        );
+    };
+    fails(&["--frames", "3"], "3 asked for, the sequence has 2");
+    let image = display(&f.left().join(frame_name(0)));
+    fails(&["--left-image", &image], "--left-image");
+    let broken = f.right().join(frame_name(1));
+    std::fs::write(&broken, "this is not a PNG\n").expect("write text");
+    fails(&[], &display(&broken));
 }

@@ -1,9 +1,13 @@
-//! A sequence made from one real rectified pair by injecting an exact verge per frame, written
+//! A sequence made from real rectified frames by injecting an exact verge per frame, written
 //! in the formats every tool reads (`left/`, `right/`, `calib.toml`, `truth.csv`), so that
 //! `stereocal run --truth` measures real-image accuracy through the whole chain.
 //!
-//! The rectification leaves an unknown constant residual verge, so the truth is exact only up
-//! to a constant: `stereocal run` removes the median offset before its statistics.
+//! The frames come from one pair repeated (the view never changes, so every error that depends
+//! on the view is constant) or from a recorded sequence, a drive whose content changes every
+//! frame, where those errors show. The rectification leaves an unknown residual verge, so the
+//! truth is exact only up to it: `stereocal run` removes the median offset before its
+//! statistics, and a bench that also runs the untouched sequence can subtract the untouched
+//! estimate of each frame, which cancels whatever depends on the view.
 //!
 //! A warped image has a border where the source ran out, which a real turning camera never
 //! shows: there the warp repeats edge pixels, and features on those smears move with the
@@ -21,6 +25,7 @@ use rayon::prelude::*;
 use super::inject::YawWarp;
 use super::SynthError;
 use crate::calib::{Calibration, CameraIntrinsics};
+use crate::sequence::{GrayFrame, StereoSequence};
 use crate::verge_csv::write_truth_csv;
 
 /// How the two cameras move over the sequence.
@@ -30,6 +35,58 @@ pub enum Motion {
     Moving,
     /// Verge fixed at 1.5° while the head's common yaw sweeps ±1° (the view changes).
     Fixed,
+    /// The verge swings ±10° (one period over the sequence), each camera taking half of it:
+    /// the range the issue's targets name for wide verges.
+    Swing,
+}
+
+/// Where the frames to warp come from.
+#[derive(Debug, Clone, Copy)]
+pub enum Source<'a> {
+    /// One pair, warped anew for every frame.
+    Pair {
+        left: &'a GrayImage,
+        right: &'a GrayImage,
+    },
+    /// A recorded sequence: output frame `i` is its pair `i`.
+    Sequence(&'a StereoSequence),
+}
+
+impl Source<'_> {
+    /// Pair `frame` and its size, checked against `first` (frame 0's size) when given.
+    fn pair(
+        &self,
+        frame: usize,
+        first: Option<(u32, u32)>,
+    ) -> Result<(GrayImage, GrayImage), SynthError> {
+        let (left, right) = match self {
+            Source::Pair { left, right } => ((*left).clone(), (*right).clone()),
+            Source::Sequence(seq) => {
+                let size = first.map(|(w, h)| (w as usize, h as usize));
+                let (l, r) = seq.pair(frame, size)?;
+                (to_image(l, frame)?, to_image(r, frame)?)
+            }
+        };
+        if left.dimensions() != right.dimensions() {
+            return Err(SynthError::InvalidConfig {
+                field: "images",
+                reason: format!(
+                    "frame {frame}: left is {:?}, right is {:?}; a pair must have one size",
+                    left.dimensions(),
+                    right.dimensions()
+                ),
+            });
+        }
+        Ok((left, right))
+    }
+}
+
+fn to_image(g: GrayFrame, frame: usize) -> Result<GrayImage, SynthError> {
+    let (w, h) = (g.width, g.height);
+    GrayImage::from_raw(w as u32, h as u32, g.pixels).ok_or(SynthError::InvalidConfig {
+        field: "images",
+        reason: format!("frame {frame}: a {w}x{h} image decoded to a different number of pixels"),
+    })
 }
 
 /// The yaws (radians) of frame `i` of `frames`: (alpha_l, alpha_r).
@@ -40,6 +97,10 @@ pub fn yaws(motion: Motion, i: usize, frames: usize) -> (f64, f64) {
         Motion::Fixed => {
             let common = phase.sin();
             (common + 0.75, common - 0.75)
+        }
+        Motion::Swing => {
+            let half = 5.0 * phase.sin();
+            (half, -half)
         }
     };
     (l.to_radians(), r.to_radians())
@@ -121,14 +182,13 @@ fn cropped_camera(camera: &CameraIntrinsics, window: Window) -> CameraIntrinsics
     }
 }
 
-/// Writes `frames` injected pairs of (`left`, `right`) into `dir` (which must not exist or be
+/// Writes `frames` injected pairs of `source` into `dir` (which must not exist or be
 /// empty), cropped to the [`common_window`] of the sequence, with `calib.toml` (principal
 /// points moved with the crop) and `truth.csv`. Everything is written to a sibling staging
 /// directory first and renamed into place, so a failure leaves nothing half-written.
 pub fn write_injected(
     dir: &Path,
-    left: &GrayImage,
-    right: &GrayImage,
+    source: Source<'_>,
     calib: &Calibration,
     motion: Motion,
     frames: usize,
@@ -144,17 +204,15 @@ pub fn write_injected(
             reason: "must be at least 1".into(),
         });
     }
-    if left.dimensions() != right.dimensions() {
-        return Err(SynthError::InvalidConfig {
-            field: "images",
-            reason: format!(
-                "left is {:?}, right is {:?}; a pair must have one size",
-                left.dimensions(),
-                right.dimensions()
-            ),
-        });
+    if let Source::Sequence(seq) = source {
+        if frames > seq.len() {
+            return Err(SynthError::InvalidConfig {
+                field: "frames",
+                reason: format!("{frames} asked for, the sequence has {}", seq.len()),
+            });
+        }
     }
-    let (width, height) = left.dimensions();
+    let (width, height) = source.pair(0, None)?.0.dimensions();
     let warps: Vec<YawWarp> = (0..frames)
         .flat_map(|i| {
             let (al, ar) = yaws(motion, i, frames);
@@ -193,9 +251,10 @@ pub fn write_injected(
     (0..frames).into_par_iter().try_for_each(|i| {
         let (al, ar) = yaws(motion, i, frames);
         let name = format!("{i:06}.png");
+        let (left, right) = source.pair(i, Some((width, height)))?;
         for (d, img, cam, alpha) in [
-            (&ldir, left, &calib.left, al),
-            (&rdir, right, &calib.right, ar),
+            (&ldir, &left, &calib.left, al),
+            (&rdir, &right, &calib.right, ar),
         ] {
             let path = d.join(&name);
             let warped = YawWarp::new(cam, alpha).apply(img);
@@ -250,7 +309,11 @@ mod tests {
             right: cam,
         };
         let dir = tmp.path().join("set");
-        write_injected(&dir, &img, &img, &calib, Motion::Moving, 4, &|_| {}).unwrap();
+        let pair = Source::Pair {
+            left: &img,
+            right: &img,
+        };
+        write_injected(&dir, pair, &calib, Motion::Moving, 4, &|_| {}).unwrap();
         assert_eq!(fs::read_dir(dir.join("left")).unwrap().count(), 4);
         assert_eq!(fs::read_dir(dir.join("right")).unwrap().count(), 4);
         let truth = crate::verge_csv::read_truth_csv(&dir.join("truth.csv")).unwrap();
@@ -264,8 +327,87 @@ mod tests {
         // Only the finished directory is left beside it.
         assert_eq!(fs::read_dir(tmp.path()).unwrap().count(), 1);
         // A second run into the now non-empty directory is refused.
-        let again = write_injected(&dir, &img, &img, &calib, Motion::Fixed, 2, &|_| {});
+        let again = write_injected(&dir, pair, &calib, Motion::Fixed, 2, &|_| {});
         assert!(matches!(again, Err(SynthError::OutputNotEmpty(_))));
+    }
+
+    #[test]
+    fn injects_into_every_frame_of_a_sequence() {
+        use crate::sequence::{SizeLimits, StereoSequence};
+        let tmp = tempfile::tempdir().unwrap();
+        let (src_l, src_r) = (tmp.path().join("l"), tmp.path().join("r"));
+        // Three different pairs, as a drive's content changes every frame.
+        let frame = |k: u32, side: u32| {
+            GrayImage::from_fn(64, 48, move |x, y| {
+                image::Luma([((x * 7 + y * (3 + side) + k * 50) % 251) as u8])
+            })
+        };
+        for (dir, side) in [(&src_l, 0), (&src_r, 1)] {
+            fs::create_dir(dir).unwrap();
+            for k in 0..3 {
+                frame(k, side)
+                    .save(dir.join(format!("{k:04}.png")))
+                    .unwrap();
+            }
+        }
+        let limits = SizeLimits {
+            max_width: 4096,
+            min_side: 16,
+        };
+        let seq = StereoSequence::open(&src_l, &src_r, limits).unwrap();
+        let cam = CameraIntrinsics::pinhole(60.0, 60.0, 32.0, 24.0);
+        let calib = Calibration {
+            baseline_m: 0.3,
+            left: cam,
+            right: cam,
+        };
+        let dir = tmp.path().join("set");
+        let source = Source::Sequence(&seq);
+        write_injected(&dir, source, &calib, Motion::Swing, 3, &|_| {}).unwrap();
+        let truth = crate::verge_csv::read_truth_csv(&dir.join("truth.csv")).unwrap();
+        assert_eq!(truth.len(), 3);
+        for (i, t) in truth.iter().enumerate() {
+            let (al, ar) = yaws(Motion::Swing, i, 3);
+            assert!((t - (al - ar).to_degrees()).abs() < 1e-6);
+        }
+        // One period of ±10°: frames 1 and 2 sit at ±10·sin(120°).
+        assert!((truth[1] - 10.0 * 120f64.to_radians().sin()).abs() < 1e-6);
+        assert!((truth[2] + truth[1]).abs() < 1e-6);
+        let written = Calibration::load(dir.join("calib.toml")).unwrap();
+        let (x0, y0) = (
+            (cam.cx - written.left.cx) as u32,
+            (cam.cy - written.left.cy) as u32,
+        );
+        // Output frame i is source pair i warped by frame i's yaw, cropped.
+        for i in 0..3u32 {
+            let (al, ar) = yaws(Motion::Swing, i as usize, 3);
+            for (side, name, alpha) in [(0, "left", al), (1, "right", ar)] {
+                let got = image::open(dir.join(format!("{name}/{i:06}.png")))
+                    .unwrap()
+                    .to_luma8();
+                let want = YawWarp::new(&cam, alpha).apply(&frame(i, side));
+                let want =
+                    image::imageops::crop_imm(&want, x0, y0, got.width(), got.height()).to_image();
+                assert_eq!(got, want, "{name} frame {i}");
+            }
+        }
+        // More frames than the sequence holds are refused before anything is written.
+        let more = write_injected(
+            &tmp.path().join("more"),
+            source,
+            &calib,
+            Motion::Fixed,
+            4,
+            &|_| {},
+        );
+        assert!(matches!(
+            more,
+            Err(SynthError::InvalidConfig {
+                field: "frames",
+                ..
+            })
+        ));
+        assert!(!tmp.path().join("more").exists());
     }
 
     #[test]

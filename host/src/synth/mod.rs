@@ -53,6 +53,8 @@ pub enum SynthError {
         #[source]
         source: std::io::Error,
     },
+    #[error(transparent)]
+    Sequence(#[from] crate::sequence::SequenceError),
     #[error("{path}: {source}")]
     Image {
         path: PathBuf,
