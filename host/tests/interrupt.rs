@@ -1,7 +1,7 @@
 //! Ctrl-C during `stereocal run`'s final write leaves nothing behind: no staging directory,
 //! and in `--out` either the previous `verge.csv` and `verge.png` or the new ones, never one of
-//! each. Ctrl-C while `stereocal synth` writes a sequence leaves neither its staging directory
-//! nor a part of the sequence.
+//! each. Ctrl-C while `stereocal synth` or `stereocal inject` writes a sequence leaves neither
+//! its staging directory nor a part of the sequence.
 //!
 //! The test watches the output directory and sends SIGINT once the run's staging directory
 //! appears, after a delay that grows from trial to trial, so that the signals land while the
@@ -181,26 +181,73 @@ fn ctrl_c_during_the_final_write_leaves_the_old_output_or_the_new_and_no_staging
 fn ctrl_c_while_synth_writes_leaves_no_staging_and_no_part_of_the_sequence() {
     let root = tempfile::tempdir().unwrap();
     let out = root.path().join("sequence");
+    interrupt_sequence_writer(
+        root.path(),
+        &out,
+        &["synth", "--scene", "road", "--frames", "8", "--seed", "1"],
+    );
+}
+
+#[test]
+fn ctrl_c_while_inject_writes_leaves_no_staging_and_no_part_of_the_sequence() {
+    let root = tempfile::tempdir().unwrap();
+    let big = |shift: u32| {
+        GrayImage::from_fn(640, 480, |x, y| {
+            let x = x + shift;
+            Luma([((x * 37 + y * 91 + (x * y) % 29 * 5) % 256) as u8])
+        })
+    };
+    let (left, right, calib) = (
+        root.path().join("l.png"),
+        root.path().join("r.png"),
+        root.path().join("calib.toml"),
+    );
+    big(0).save(&left).unwrap();
+    big(7).save(&right).unwrap();
+    std::fs::write(&calib, CALIB).unwrap();
+    let out = root.path().join("sequence");
+    let arg = |p: &Path| p.to_str().unwrap().to_string();
+    interrupt_sequence_writer(
+        root.path(),
+        &out,
+        &[
+            "inject",
+            "--left-image",
+            &arg(&left),
+            "--right-image",
+            &arg(&right),
+            "--calib",
+            &arg(&calib),
+            "--frames",
+            "60",
+        ],
+    );
+}
+
+/// Runs `stereocal ARGS --out OUT`, sends SIGINT once its staging directory appears in
+/// `root`, and checks that it ended by the signal with neither the staging directory nor any
+/// part of `out` left.
+fn interrupt_sequence_writer(root: &Path, out: &Path, args: &[&str]) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_stereocal"))
-        .args([
-            "synth", "--scene", "road", "--frames", "8", "--seed", "1", "--out",
-        ])
-        .arg(&out)
+        .args(args)
+        .arg("--out")
+        .arg(out)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .expect("stereocal runs");
     let started = Instant::now();
-    while staging_entries(root.path()).is_empty() {
+    while staging_entries(root).is_empty() {
         assert!(
             child.try_wait().unwrap().is_none(),
-            "synth ended before its staging directory was seen"
+            "{} ended before its staging directory was seen",
+            args[0]
         );
         assert!(started.elapsed() < Duration::from_secs(60), "no staging");
     }
     interrupt(&child);
     let status = child.wait().unwrap();
-    let left = staging_entries(root.path());
+    let left = staging_entries(root);
     assert!(left.is_empty(), "left behind: {left:?}");
     assert_eq!(status.code(), Some(130), "{status}");
     assert!(

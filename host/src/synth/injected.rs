@@ -25,6 +25,7 @@ use rayon::prelude::*;
 use super::inject::YawWarp;
 use super::SynthError;
 use crate::calib::{Calibration, CameraIntrinsics};
+use crate::output_dir::StagingDir;
 use crate::sequence::{GrayFrame, StereoSequence};
 use crate::verge_csv::write_truth_csv;
 
@@ -184,8 +185,9 @@ fn cropped_camera(camera: &CameraIntrinsics, window: Window) -> CameraIntrinsics
 
 /// Writes `frames` injected pairs of `source` into `dir` (which must not exist or be
 /// empty), cropped to the [`common_window`] of the sequence, with `calib.toml` (principal
-/// points moved with the crop) and `truth.csv`. Everything is written to a sibling staging
-/// directory first and renamed into place, so a failure leaves nothing half-written.
+/// points moved with the crop) and `truth.csv`. Everything is written to a sibling
+/// [`StagingDir`] first and renamed into place, so neither a failure nor Ctrl-C leaves
+/// anything half-written.
 pub fn write_injected(
     dir: &Path,
     source: Source<'_>,
@@ -240,10 +242,7 @@ pub fn write_injected(
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     fs::create_dir_all(parent).map_err(io(parent))?;
-    let staging = tempfile::Builder::new()
-        .prefix(".stereocal-inject-")
-        .tempdir_in(parent)
-        .map_err(io(parent))?;
+    let staging = StagingDir::new_in(parent).map_err(io(parent))?;
     let (ldir, rdir) = (staging.path().join("left"), staging.path().join("right"));
     for d in [&ldir, &rdir] {
         fs::create_dir_all(d).map_err(io(d))?;
@@ -280,17 +279,7 @@ pub fn write_injected(
     })?;
     let calib_path = staging.path().join("calib.toml");
     fs::write(&calib_path, cropped.to_toml_string()).map_err(io(&calib_path))?;
-    if dir.exists() {
-        fs::remove_dir(dir).map_err(io(dir))?;
-    }
-    let staged = staging.keep();
-    fs::rename(&staged, dir).map_err(|source| {
-        let _ = fs::remove_dir_all(&staged);
-        SynthError::Io {
-            path: dir.to_path_buf(),
-            source,
-        }
-    })
+    staging.persist(dir).map_err(io(dir))
 }
 
 #[cfg(test)]
