@@ -472,7 +472,7 @@ fn guided_pairs(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calib::CameraIntrinsics;
+    use crate::calib::{CameraIntrinsics, Extrinsics};
     use crate::essential::rot_y;
     use crate::essential::testutil::synthetic;
 
@@ -516,6 +516,7 @@ mod tests {
             baseline_m: 0.11,
             left: cam,
             right: cam,
+            extrinsics: Extrinsics::default(),
         };
         let truth = VergeAngles::new(1.2f64.to_radians(), -0.7f64.to_radians());
         let pairs = pixel_matches(&calib, truth, 600, 9);
@@ -550,6 +551,7 @@ mod tests {
             baseline_m: 0.3,
             left: cam,
             right: cam,
+            extrinsics: Extrinsics::default(),
         };
         let truth = VergeAngles::new(9f64.to_radians(), -6f64.to_radians());
         let pairs = pixel_matches(&calib, truth, 200, 4);
