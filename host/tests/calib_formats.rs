@@ -321,3 +321,24 @@ fn run_names_the_bad_key_and_writes_nothing() {
         out.display()
     );
 }
+
+#[test]
+fn inject_refuses_an_unrectified_pair() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = stereocal(&[
+        "inject",
+        "--left-image",
+        "left.png",
+        "--right-image",
+        "right.png",
+        "--calib",
+        fixture("verged-camchain.yaml").to_str().unwrap(),
+        "--out",
+        dir.path().join("set").to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    for needle in ["verged-camchain.yaml", "unrectified", "verge 1.2000°"] {
+        assert!(stderr.contains(needle), "`{needle}` missing from: {stderr}");
+    }
+}

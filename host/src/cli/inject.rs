@@ -28,7 +28,7 @@ pub struct InjectArgs {
     /// Right image of the pair.
     #[arg(long)]
     right_image: PathBuf,
-    /// Calibration of the rectified pair (TOML, as for `run`).
+    /// Calibration of the rectified pair, in any format `run` reads.
     #[arg(long)]
     calib: PathBuf,
     /// Frame pairs to write.
@@ -44,6 +44,16 @@ pub struct InjectArgs {
 
 pub fn inject(args: &InjectArgs) -> anyhow::Result<()> {
     let calib = Calibration::load(&args.calib)?;
+    // The injected yaws are the truth only when they start from a parallel head.
+    anyhow::ensure!(
+        calib.extrinsics.is_zero(),
+        "calibration {}: describes an unrectified pair (verge {:.4}°, pitch {:.4}°, roll {:.4}°); \
+         inject needs a rectified one",
+        args.calib.display(),
+        calib.extrinsics.verge_deg,
+        calib.extrinsics.pitch_deg,
+        calib.extrinsics.roll_deg
+    );
     let image = |path: &PathBuf| -> anyhow::Result<GrayImage> {
         let g = load_gray(path)?;
         GrayImage::from_raw(g.width as u32, g.height as u32, g.pixels)
