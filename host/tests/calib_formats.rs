@@ -1,7 +1,8 @@
 //! `--calib` reads the calibrations users already have: OpenCV's `stereoCalibrate` results as
 //! `cv::FileStorage` writes them, a Kalibr camchain and KITTI's `calib.txt`, recognised by
 //! content. The fixtures in `tests/data/calib/` hold two rigs, each written in its tools' own
-//! conventions: the rendered road head (rectified; all four formats) and a raw head verged by
+//! conventions: the rendered road head (rectified; all four formats, OpenCV's as YAML and as
+//! JSON) and a raw head verged by
 //! 1.2° with fixed misalignments (TOML, OpenCV, Kalibr; KITTI holds only rectified pairs).
 //! Every file of a rig must read as that rig's TOML, `stereocal run` must estimate the same on
 //! each, and each bad file must be refused with the file, key and line named.
@@ -57,7 +58,12 @@ fn assert_same_rig(name: &str, got: &Calibration, want: &Calibration) {
 fn every_format_of_the_rectified_rig_reads_as_its_toml() {
     let toml = load("road.toml");
     assert!(toml.extrinsics.is_zero());
-    for name in ["road-opencv.yml", "road-camchain.yaml", "road-kitti.txt"] {
+    for name in [
+        "road-opencv.yml",
+        "road-opencv.json",
+        "road-camchain.yaml",
+        "road-kitti.txt",
+    ] {
         let got = load(name);
         assert_same_rig(name, &got, &toml);
         // A rectified pair has no pose at all, not a pose of rounding errors.
@@ -133,7 +139,12 @@ fn run_on_each_format_estimates_what_run_on_the_toml_does() {
         std::fs::read_to_string(out.join("verge.csv")).unwrap()
     };
     let toml = run("road.toml");
-    for calib in ["road-opencv.yml", "road-camchain.yaml", "road-kitti.txt"] {
+    for calib in [
+        "road-opencv.yml",
+        "road-opencv.json",
+        "road-camchain.yaml",
+        "road-kitti.txt",
+    ] {
         assert_eq!(
             run(calib),
             toml,
@@ -230,6 +241,9 @@ fn opencv_errors_name_the_file_key_and_line() {
         &bad,
         &["`R`", &line(at - 4), "not a rotation"],
     );
+    // XML storage is named as such, not taken for broken TOML.
+    let xml = "<?xml version=\"1.0\"?>\n<opencv_storage>\n<R type_id=\"opencv-matrix\">\n";
+    assert_refused("stereo.xml", xml, &["XML", "YAML or JSON"]);
 }
 
 #[test]

@@ -6,8 +6,10 @@
 pub enum Format {
     /// The project's own TOML.
     Toml,
-    /// `cv::FileStorage` YAML with `stereoCalibrate`'s K1, D1, K2, D2, R, T.
+    /// `cv::FileStorage` YAML or JSON with `stereoCalibrate`'s K1, D1, K2, D2, R, T.
     OpenCv,
+    /// `cv::FileStorage` XML, which is recognised only to say so.
+    OpenCvXml,
     /// Kalibr's `camchain.yaml` (`cam0`, `cam1` with `T_cn_cnm1`).
     Kalibr,
     /// KITTI's `calib.txt` (`P0:` … `P3:`) or raw-data `calib_cam_to_cam.txt` (`P_rect_00:` …).
@@ -15,14 +17,18 @@ pub enum Format {
 }
 
 impl Format {
-    /// Recognises the format by marks no other of them has: `%YAML:1.0` or an
-    /// `!!opencv-matrix` (OpenCV), a top-level `cam0:` (Kalibr), a line starting `P0:` or
-    /// `P_rect_00:` (KITTI). None of these is valid TOML, so everything else is TOML.
+    /// Recognises the format by marks no other of them has: `<opencv_storage>` (OpenCV XML),
+    /// `%YAML:1.0` or an `opencv-matrix` type (OpenCV YAML, JSON), a top-level `cam0:`
+    /// (Kalibr), a line starting `P0:` or `P_rect_00:` (KITTI). None of these is valid TOML,
+    /// so everything else is TOML.
     pub fn detect(text: &str) -> Self {
         let text = text.trim_start_matches('\u{feff}');
+        if text.contains("<opencv_storage>") {
+            return Self::OpenCvXml;
+        }
         let opencv_matrix = text
             .lines()
-            .any(|l| !l.trim_start().starts_with('#') && l.contains("!!opencv-matrix"));
+            .any(|l| !l.trim_start().starts_with('#') && l.contains("opencv-matrix"));
         if text.trim_start().starts_with("%YAML:") || opencv_matrix {
             return Self::OpenCv;
         }
@@ -50,6 +56,16 @@ mod tests {
         assert_eq!(
             Format::detect("R: !!opencv-matrix\n   rows: 3\n"),
             Format::OpenCv
+        );
+        assert_eq!(
+            Format::detect("{\n    \"R\": {\n        \"type_id\": \"opencv-matrix\",\n"),
+            Format::OpenCv
+        );
+        assert_eq!(
+            Format::detect(
+                "<?xml version=\"1.0\"?>\n<opencv_storage>\n<R type_id=\"opencv-matrix\">"
+            ),
+            Format::OpenCvXml
         );
         assert_eq!(
             Format::detect("cam0:\n  camera_model: pinhole\ncam1:\n"),

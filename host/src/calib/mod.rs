@@ -8,7 +8,7 @@
 //! error that names it.
 //!
 //! [`Calibration::load`] also reads the files users already have, recognised by content (see
-//! [`Format`]): OpenCV's `stereoCalibrate` results written by `cv::FileStorage`, a Kalibr
+//! [`Format`]): OpenCV's `stereoCalibrate` results written by `cv::FileStorage` (YAML or JSON), a Kalibr
 //! `camchain.yaml` and KITTI's `calib.txt`. Each maps into the same [`Calibration`], so the
 //! TOML can say everything they can.
 
@@ -274,6 +274,12 @@ impl Calibration {
         match Format::detect(text) {
             Format::Toml => Self::from_toml_str(text, path),
             Format::OpenCv => opencv::parse(text, path),
+            Format::OpenCvXml => Err(CalibError::Parse {
+                path: path.to_owned(),
+                message: "is OpenCV's XML storage, which is not read: save it as YAML or JSON \
+                          (cv::FileStorage with a .yml or .json name)"
+                    .into(),
+            }),
             Format::Kalibr => kalibr::parse(text, path),
             Format::Kitti => kitti::parse(text, path),
         }

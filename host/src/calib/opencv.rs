@@ -1,5 +1,6 @@
 //! OpenCV's stereo calibration as `cv::FileStorage` writes it: `%YAML:1.0`, then the results of
-//! `stereoCalibrate` as `!!opencv-matrix` maps (`rows`, `cols`, `dt`, `data`). The keys are
+//! `stereoCalibrate` as `!!opencv-matrix` maps (`rows`, `cols`, `dt`, `data`); its JSON (a
+//! `.json` name) is the same maps with `"type_id": "opencv-matrix"`, and JSON is YAML. The keys are
 //! `K1, D1, K2, D2, R, T`; OpenCV's own sample names the camera matrices `M1, M2` and some
 //! scripts `cameraMatrix1, distCoeffs1`, which are read too. T is in the units of the object
 //! points given to `stereoCalibrate`, here taken as metres.
