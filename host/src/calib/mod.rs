@@ -3,14 +3,14 @@
 //! The project's format is TOML (ARCHITECTURE.md): top-level `baseline_m`, and `[left]` /
 //! `[right]` tables with `fx, fy, cx, cy` in pixels. **Extensions:** each camera table may
 //! also carry the OpenCV radial-tangential distortion `k1, k2, p1, p2, k3` (all default to 0),
-//! which raw (unrectified) cameras such as EuRoC need, and an `[extrinsics]` table the pose of
-//! an unrectified pair (see [`Extrinsics`]; absent: a rectified pair). Any other key is an
-//! error that names it.
+//! which raw (unrectified) cameras such as EuRoC need, and an `[extrinsics]` table with the
+//! pose of an unrectified pair (see [`Extrinsics`]; absent: a rectified pair). Any other key is
+//! an error that names it.
 //!
 //! [`Calibration::load`] also reads the files users already have, recognised by content (see
-//! [`Format`]): OpenCV's `stereoCalibrate` results written by `cv::FileStorage` (YAML or JSON), a Kalibr
-//! `camchain.yaml` and KITTI's `calib.txt`. Each maps into the same [`Calibration`], so the
-//! TOML can say everything they can.
+//! [`Format`]): OpenCV's `stereoCalibrate` results written by `cv::FileStorage` (YAML or JSON),
+//! a Kalibr `camchain.yaml` and KITTI's `calib.txt`. Each maps into the same [`Calibration`],
+//! so the TOML can say everything they can.
 
 mod extrinsics;
 mod format;
@@ -38,8 +38,9 @@ pub enum CalibError {
         #[source]
         source: std::io::Error,
     },
-    /// The TOML is malformed, a key is unknown or missing, or a value has the wrong type.
-    /// The message from the TOML parser names the key, the expected type and the line.
+    /// The TOML is malformed, a key is unknown or missing, or a value has the wrong type (the
+    /// TOML parser's message names the key, the expected type and the line); or the YAML of an
+    /// OpenCV or Kalibr file is malformed (the YAML parser's message names the line).
     #[error("calibration {path}: {message}")]
     Parse { path: PathBuf, message: String },
     /// A value parsed but is physically impossible (e.g. a focal length ≤ 0).
