@@ -10,7 +10,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
-use stereocal::calib::{Calibration, CameraIntrinsics};
+use stereocal::calib::{Calibration, CameraIntrinsics, Extrinsics};
 use stereocal::descriptor::{describe, DescriptorConfig};
 use stereocal::estimator::{EstimatorConfig, VergeEstimator};
 use stereocal::frame::{FeatureFrame, Gradients, Keypoint, SobelPlane};
@@ -99,6 +99,7 @@ fn bench(c: &mut Criterion) {
         baseline_m: 0.3,
         left: cam,
         right: cam,
+        extrinsics: Extrinsics::default(),
     };
     let config = EstimatorConfig::default();
     let estimator = VergeEstimator::new(calib, config);

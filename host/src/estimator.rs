@@ -254,7 +254,7 @@ impl VergeEstimator {
         // The thesis' solve (4.5): e1..e4 by SVD, rank 2 enforced, the 180° ambiguity
         // resolved, over RANSAC's consensus set (or every match without RANSAC), each match
         // weighted as the refinement weighs it. Its angles start the refinement, and so does
-        // RANSAC's own hypothesis (or the parallel head): on a near-planar scene the linear
+        // RANSAC's own hypothesis (or the calibrated head): on a near-planar scene the linear
         // system loses rank and its solution can be far off, and without RANSAC it also saw
         // the outliers. The lower robust cost wins.
         let (consensus, fallback) = match self.config.ransac {
@@ -266,7 +266,10 @@ impl VergeEstimator {
                 let found = ransac(&corr, &cfg)?;
                 (found.inliers, found.angles)
             }
-            None => (vec![true; corr.len()], VergeAngles::new(0.0, 0.0)),
+            None => (
+                vec![true; corr.len()],
+                VergeAngles::from_extrinsics(&self.calib.extrinsics),
+            ),
         };
         let linear_weights: Vec<f64> = corr
             .iter()
@@ -297,11 +300,11 @@ impl VergeEstimator {
         };
         if self.config.model == Model::General {
             // Two starts: the constrained solution (right when the head only verges) and the
-            // nominal parallel head (right when a tilt misleads the constrained fit); the
-            // lower robust cost on a common scale wins.
+            // calibrated head with its fixed misalignments (right when a tilt misleads the
+            // constrained fit); the lower robust cost on a common scale wins.
             let starts = [
                 RelativePose::from_verge(cfit.angles),
-                RelativePose::from_verge(VergeAngles::new(0.0, 0.0)),
+                RelativePose::from_extrinsics(&self.calib.extrinsics),
             ];
             let gfit = lowest_cost(
                 starts
@@ -472,7 +475,7 @@ fn guided_pairs(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calib::CameraIntrinsics;
+    use crate::calib::{CameraIntrinsics, Extrinsics};
     use crate::essential::rot_y;
     use crate::essential::testutil::synthetic;
 
@@ -516,6 +519,7 @@ mod tests {
             baseline_m: 0.11,
             left: cam,
             right: cam,
+            extrinsics: Extrinsics::default(),
         };
         let truth = VergeAngles::new(1.2f64.to_radians(), -0.7f64.to_radians());
         let pairs = pixel_matches(&calib, truth, 600, 9);
@@ -550,6 +554,7 @@ mod tests {
             baseline_m: 0.3,
             left: cam,
             right: cam,
+            extrinsics: Extrinsics::default(),
         };
         let truth = VergeAngles::new(9f64.to_radians(), -6f64.to_radians());
         let pairs = pixel_matches(&calib, truth, 200, 4);

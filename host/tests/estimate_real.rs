@@ -18,7 +18,7 @@ use std::path::PathBuf;
 
 use image::GrayImage;
 use rayon::prelude::*;
-use stereocal::calib::{Calibration, CameraIntrinsics};
+use stereocal::calib::{Calibration, CameraIntrinsics, Extrinsics};
 use stereocal::estimator::{EstimatorConfig, FrameEstimate, Model, VergeEstimator};
 use stereocal::frame::{FeatureFrame, Gradients, Keypoint, SobelPlane};
 use stereocal::kalman::{KalmanConfig, Measurement, VergeFilter};
@@ -162,6 +162,7 @@ fn eth3d_scenes(root: &std::path::Path) -> Vec<Scene> {
                     baseline_m: g["stereo"]["baseline_m"].as_f64().expect("baseline"),
                     left: camera(&g["cam0"]),
                     right: camera(&g["cam1"]),
+                    extrinsics: Extrinsics::default(),
                 },
             }
         })
@@ -393,6 +394,7 @@ fn euroc_raw_pairs_with_the_general_model() {
         baseline_m: geo["stereo"]["baseline_m"].as_f64().expect("baseline"),
         left: camera(&geo["cam0"]),
         right: camera(&geo["cam1"]),
+        extrinsics: Extrinsics::default(),
     };
     let ypr = &geo["stereo"]["yaw_pitch_roll_deg"];
     let truth_verge = -ypr[0].as_f64().expect("yaw");

@@ -1,6 +1,7 @@
-//! Arbitrary text into the calibration parser (`Calibration::from_toml_str`, what
-//! `Calibration::load` and the CLI's `--calib` use). Nothing may panic; a calibration that
-//! parses must be valid and must survive `to_toml_string` → `from_toml_str` unchanged.
+//! Arbitrary text into the calibration readers (`Calibration::from_str_any`, what
+//! `Calibration::load` and the CLI's `--calib` use: TOML, OpenCV YAML, Kalibr, KITTI). Nothing
+//! may panic; a calibration that parses must be valid and must survive `to_toml_string` →
+//! `from_toml_str` unchanged, whichever format it came in.
 //! Bytes that are not UTF-8 go in lossily converted, so every input reaches the parser.
 #![no_main]
 
@@ -9,7 +10,7 @@ use stereocal::calib::Calibration;
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
-    if let Ok(calib) = Calibration::from_toml_str(&text, "fuzz.toml") {
+    if let Ok(calib) = Calibration::from_str_any(&text, "fuzz.toml") {
         calib
             .validate("fuzz.toml".as_ref())
             .expect("a parsed calibration is valid");

@@ -43,7 +43,7 @@ pub struct InjectArgs {
     /// Directory of right-camera images of the sequence.
     #[arg(long, requires = "left")]
     right: Option<PathBuf>,
-    /// Calibration of the rectified pair (TOML, as for `run`).
+    /// Calibration of the rectified pair, in any format `run` reads.
     #[arg(long)]
     calib: PathBuf,
     /// Frame pairs to write (default: 60 from a pair, every pair of a sequence; from a
@@ -66,6 +66,16 @@ enum Input {
 
 pub fn inject(args: &InjectArgs) -> anyhow::Result<()> {
     let calib = Calibration::load(&args.calib)?;
+    // The injected yaws are the truth only when they start from a parallel head.
+    anyhow::ensure!(
+        calib.extrinsics.is_zero(),
+        "calibration {}: describes an unrectified pair (verge {:.4}°, pitch {:.4}°, roll {:.4}°); \
+         inject needs a rectified one",
+        args.calib.display(),
+        calib.extrinsics.verge_deg,
+        calib.extrinsics.pitch_deg,
+        calib.extrinsics.roll_deg
+    );
     let image = |path: &PathBuf| -> anyhow::Result<GrayImage> {
         let g = load_gray(path)?;
         GrayImage::from_raw(g.width as u32, g.height as u32, g.pixels)

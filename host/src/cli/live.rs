@@ -35,7 +35,10 @@ pub struct LiveArgs {
     /// Unix socket of the device (e.g. QEMU's `-chardev socket,path=..,server=on`).
     #[arg(long, value_name = "PATH")]
     unix: Option<PathBuf>,
-    /// Calibration file (TOML: baseline_m, [left] and [right] fx, fy, cx, cy).
+    /// Calibration file, recognised by content: the project's TOML (baseline_m, [left] and
+    /// [right] fx, fy, cx, cy, optional k1, k2, p1, p2, k3 and [extrinsics]), OpenCV's
+    /// stereoCalibrate results written by cv::FileStorage (K1, D1, K2, D2, R, T; T in metres),
+    /// a Kalibr camchain.yaml (cam0, cam1) or KITTI's calib.txt (P0, P1 or P_rect_00, P_rect_01).
     #[arg(long)]
     calib: PathBuf,
     /// Width of the cameras' frames, as the fabric is to be configured.

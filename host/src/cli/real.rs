@@ -27,7 +27,10 @@ pub struct RunArgs {
     /// Directory of right-camera images.
     #[arg(long)]
     right: PathBuf,
-    /// Calibration file (TOML: baseline_m, [left] and [right] fx, fy, cx, cy).
+    /// Calibration file, recognised by content: the project's TOML (baseline_m, [left] and
+    /// [right] fx, fy, cx, cy, optional k1, k2, p1, p2, k3 and [extrinsics]), OpenCV's
+    /// stereoCalibrate results written by cv::FileStorage (K1, D1, K2, D2, R, T; T in metres),
+    /// a Kalibr camchain.yaml (cam0, cam1) or KITTI's calib.txt (P0, P1 or P_rect_00, P_rect_01).
     #[arg(long)]
     calib: PathBuf,
     /// Ground truth `frame,verge_deg`: the error statistics are reported against it. A real

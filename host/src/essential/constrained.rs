@@ -7,6 +7,7 @@
 use nalgebra::{Matrix2, Matrix3, Matrix4, Vector2, Vector3};
 
 use super::{mad_sigma, Correspondence, EssentialError, RefineConfig};
+use crate::calib::Extrinsics;
 
 /// The two camera yaws of a verging head, in radians (signs: `docs/ARCHITECTURE.md`, "Frames
 /// and signs").
@@ -26,6 +27,13 @@ impl VergeAngles {
     /// `alpha_l - alpha_r` in radians: toe-in positive.
     pub fn verge(&self) -> f64 {
         self.alpha_l - self.alpha_r
+    }
+
+    /// The yaws of the head the calibration describes (a rectified pair: both zero). Its
+    /// pitch, roll and baseline tilt are beyond this model.
+    pub fn from_extrinsics(e: &Extrinsics) -> Self {
+        let alpha_l = e.left_yaw_deg.to_radians();
+        Self::new(alpha_l, alpha_l - e.verge_deg.to_radians())
     }
 
     /// The verge angle in degrees.
@@ -294,6 +302,24 @@ mod tests {
     use super::super::testutil::synthetic;
     use super::super::{rot_y, sampson_residual, skew, RobustLoss};
     use super::*;
+
+    /// A verged head's R, T give the two yaws whose essential matrix explains its matches.
+    #[test]
+    fn the_calibrated_yaws_explain_a_verged_head() {
+        let (r_left, r_right) = (rot_y(0.02), rot_y(-0.015));
+        let t = Vector3::new(0.3, 0.0, 0.0);
+        let (r, tr) = (r_right.transpose() * r_left, -(r_right.transpose() * t));
+        let (e, _) = crate::calib::Extrinsics::from_rotation_translation(&r, &tr).unwrap();
+        let a = VergeAngles::from_extrinsics(&e);
+        assert!(
+            (a.alpha_l - 0.02).abs() < 1e-12 && (a.alpha_r + 0.015).abs() < 1e-12,
+            "{a:?}"
+        );
+        for c in synthetic(r_left, r_right, 0.3, 50, 0.0, 500.0, 6) {
+            let res = sampson_residual(&a.essential(), &c);
+            assert!(res.abs() < 1e-12, "{res}");
+        }
+    }
 
     #[test]
     fn sparse_residual_and_gradient_match_the_matrix_form() {

@@ -10,6 +10,7 @@ use super::constrained::VergeAngles;
 use super::{
     mad_sigma, rot_y, sampson_residual, skew, Correspondence, EssentialError, RefineConfig,
 };
+use crate::calib::Extrinsics;
 
 /// Relative pose of the right camera with respect to the left one.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +50,20 @@ impl RelativePose {
             rotation: Rotation3::from_matrix_unchecked(r),
             baseline: Unit::new_normalize(r * centre_in_left),
         }
+    }
+
+    /// The pose the calibration describes. A head that only verges (no pitch, roll or baseline
+    /// tilt) takes the yaw-only form, so a rectified pair starts exactly where it always did.
+    pub fn from_extrinsics(e: &Extrinsics) -> Self {
+        if e.pitch_deg == 0.0 && e.roll_deg == 0.0 && e.baseline_tilt_deg == 0.0 {
+            return Self::from_verge(VergeAngles::from_extrinsics(e));
+        }
+        let ypr = YawPitchRoll {
+            yaw: -e.verge_deg.to_radians(),
+            pitch: e.pitch_deg.to_radians(),
+            roll: e.roll_deg.to_radians(),
+        };
+        Self::from_r01(ypr, e.centre_direction())
     }
 
     /// `E = [t_r]ₓ R` with `x_rᵀ E x_l = 0`.
@@ -232,6 +247,33 @@ mod tests {
         assert!((p.verge() - a.verge()).abs() < 1e-14);
         let ypr = p.yaw_pitch_roll();
         assert!(ypr.pitch.abs() < 1e-15 && ypr.roll.abs() < 1e-15);
+    }
+
+    /// The pose a calibration tool's R, T describe (`x_r = R x_l + T`) must explain the
+    /// matches of that head exactly, whatever its verge, misalignments and baseline tilt.
+    #[test]
+    fn the_calibrated_pose_explains_its_head() {
+        use super::super::{rot_x, rot_z, sampson_residual};
+        let r_left = rot_y(0.01) * rot_x(0.004);
+        let r01 = rot_y(-0.03) * rot_x(0.006) * rot_z(-0.002);
+        let r_right = r_left * r01;
+        let t = Vector3::new(0.11, 0.0, 0.0);
+        let (r, tr) = (r_right.transpose() * r_left, -(r_right.transpose() * t));
+        let (e, b) = crate::calib::Extrinsics::from_rotation_translation(&r, &tr).unwrap();
+        assert!((b - 0.11).abs() < 1e-15);
+        let pose = RelativePose::from_extrinsics(&e);
+        assert!((pose.verge() - 0.03).abs() < 1e-12, "{}", pose.verge());
+        let essential = pose.essential();
+        for c in synthetic(r_left, r_right, 0.11, 50, 0.0, 500.0, 5) {
+            let res = sampson_residual(&essential, &c);
+            assert!(res.abs() < 1e-12, "{res}");
+        }
+        // A rectified calibration starts from the parallel head, to the bit.
+        let parallel = RelativePose::from_extrinsics(&crate::calib::Extrinsics::default());
+        assert_eq!(
+            parallel,
+            RelativePose::from_verge(VergeAngles::new(0.0, 0.0))
+        );
     }
 
     #[test]

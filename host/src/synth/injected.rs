@@ -285,7 +285,7 @@ pub fn write_injected(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calib::CameraIntrinsics;
+    use crate::calib::{CameraIntrinsics, Extrinsics};
 
     #[test]
     fn writes_pairs_truth_and_calibration_atomically() {
@@ -296,6 +296,7 @@ mod tests {
             baseline_m: 0.3,
             left: cam,
             right: cam,
+            extrinsics: Extrinsics::default(),
         };
         let dir = tmp.path().join("set");
         let pair = Source::Pair {

@@ -1,13 +1,31 @@
-//! The stereo head's calibration file (TOML) and the pixel ↔ calibrated-coordinate maps.
+//! The stereo head's calibration and the pixel ↔ calibrated-coordinate maps.
 //!
-//! Format (`docs/ARCHITECTURE.md`, "Calibration (TOML)"): top-level `baseline_m`, and `[left]` / `[right]` tables with
-//! `fx, fy, cx, cy` in pixels. **Extension:** each camera table may also carry the OpenCV
-//! radial-tangential distortion `k1, k2, p1, p2` (all default to 0), which raw (unrectified)
-//! cameras such as EuRoC need. Any other key is an error that names it.
+//! The project's format is TOML (`docs/ARCHITECTURE.md`, "Calibration (TOML)"): top-level
+//! `baseline_m`, and `[left]` / `[right]` tables with `fx, fy, cx, cy` in pixels.
+//! **Extensions:** each camera table may also carry the OpenCV radial-tangential distortion
+//! `k1, k2, p1, p2, k3` (all default to 0), which raw (unrectified) cameras such as EuRoC need,
+//! and an `[extrinsics]` table with the pose of an unrectified pair (see [`Extrinsics`];
+//! absent: a rectified pair). Any other key is an error that names it.
+//!
+//! [`Calibration::load`] also reads the files users already have, recognised by content (see
+//! [`Format`]): OpenCV's `stereoCalibrate` results written by `cv::FileStorage` (YAML or JSON),
+//! a Kalibr `camchain.yaml` and KITTI's `calib.txt`. Each maps into the same [`Calibration`],
+//! so the TOML can say everything they can.
+
+mod extrinsics;
+mod format;
+mod kalibr;
+mod kitti;
+mod opencv;
+mod rig;
+mod yaml;
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+
+pub use extrinsics::{Extrinsics, PoseError, MAX_ANGLE_DEG};
+pub use format::Format;
 
 /// Why a calibration could not be read or is not usable.
 #[derive(Debug, thiserror::Error)]
@@ -20,8 +38,9 @@ pub enum CalibError {
         #[source]
         source: std::io::Error,
     },
-    /// The TOML is malformed, a key is unknown or missing, or a value has the wrong type.
-    /// The message from the TOML parser names the key, the expected type and the line.
+    /// The TOML is malformed, a key is unknown or missing, or a value has the wrong type (the
+    /// TOML parser's message names the key, the expected type and the line); or the YAML of an
+    /// OpenCV or Kalibr file is malformed (the YAML parser's message names the line).
     #[error("calibration {path}: {message}")]
     Parse { path: PathBuf, message: String },
     /// A value parsed but is physically impossible (e.g. a focal length ≤ 0).
@@ -31,6 +50,35 @@ pub enum CalibError {
         key: &'static str,
         reason: &'static str,
     },
+    /// A key of an OpenCV, Kalibr or KITTI file is missing, malformed or unsupported; `key`
+    /// is the file's own name for it and `line` where it stands (when the format has lines).
+    #[error(
+        "calibration {path}: {}key `{key}` {reason}",
+        .line.map(|l| format!("line {l}: ")).unwrap_or_default()
+    )]
+    Key {
+        path: PathBuf,
+        key: String,
+        line: Option<usize>,
+        reason: String,
+    },
+}
+
+impl CalibError {
+    /// The error for `key` at `line` of `path`.
+    fn key(path: &Path, key: &str, line: Option<usize>, reason: impl Into<String>) -> Self {
+        Self::Key {
+            path: path.to_owned(),
+            key: key.to_owned(),
+            line,
+            reason: reason.into(),
+        }
+    }
+}
+
+/// A finite number in the notations the calibration tools write (`1.`, `-2.5e-01`, `700`).
+fn number(text: &str) -> Option<f64> {
+    text.trim().parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 /// Pinhole intrinsics of one camera plus optional radial-tangential distortion.
@@ -53,6 +101,10 @@ pub struct CameraIntrinsics {
     /// Tangential distortion, OpenCV `p2` (extension; 0 when absent).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub p2: f64,
+    /// Radial distortion, OpenCV `k3` (extension; 0 when absent): `stereoCalibrate` fits it
+    /// unless told not to.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub k3: f64,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -75,18 +127,19 @@ impl CameraIntrinsics {
             k2: 0.0,
             p1: 0.0,
             p2: 0.0,
+            k3: 0.0,
         }
     }
 
     /// True when any distortion coefficient is non-zero.
     pub fn has_distortion(&self) -> bool {
-        self.k1 != 0.0 || self.k2 != 0.0 || self.p1 != 0.0 || self.p2 != 0.0
+        self.k1 != 0.0 || self.k2 != 0.0 || self.p1 != 0.0 || self.p2 != 0.0 || self.k3 != 0.0
     }
 
     /// Applies the radial-tangential model to undistorted calibrated coordinates.
     pub fn distort_normalized(&self, x: f64, y: f64) -> (f64, f64) {
         let r2 = x * x + y * y;
-        let radial = 1.0 + r2 * (self.k1 + r2 * self.k2);
+        let radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3));
         let xd = x * radial + 2.0 * self.p1 * x * y + self.p2 * (r2 + 2.0 * x * x);
         let yd = y * radial + self.p1 * (r2 + 2.0 * y * y) + 2.0 * self.p2 * x * y;
         (xd, yd)
@@ -109,7 +162,7 @@ impl CameraIntrinsics {
         let (mut x, mut y) = (xd, yd);
         for _ in 0..UNDISTORT_ITERATIONS {
             let r2 = x * x + y * y;
-            let radial = 1.0 + r2 * (self.k1 + r2 * self.k2);
+            let radial = 1.0 + r2 * (self.k1 + r2 * (self.k2 + r2 * self.k3));
             let dx = 2.0 * self.p1 * x * y + self.p2 * (r2 + 2.0 * x * x);
             let dy = self.p1 * (r2 + 2.0 * y * y) + 2.0 * self.p2 * x * y;
             x = (xd - dx) / radial;
@@ -124,7 +177,7 @@ impl CameraIntrinsics {
     }
 
     fn validate(&self, path: &Path, side: Side) -> Result<(), CalibError> {
-        let checks: [(&'static str, &'static str, f64, bool); 8] = [
+        let checks: [(&'static str, &'static str, f64, bool); 9] = [
             (
                 side.key("fx"),
                 "must be a finite value > 0",
@@ -143,6 +196,7 @@ impl CameraIntrinsics {
             (side.key("k2"), "must be finite", self.k2, true),
             (side.key("p1"), "must be finite", self.p1, true),
             (side.key("p2"), "must be finite", self.p2, true),
+            (side.key("k3"), "must be finite", self.k3, true),
         ];
         for (key, reason, value, ok) in checks {
             if !value.is_finite() || !ok {
@@ -174,6 +228,7 @@ impl Side {
             (Side::Left, "k2") => "left.k2",
             (Side::Left, "p1") => "left.p1",
             (Side::Left, "p2") => "left.p2",
+            (Side::Left, "k3") => "left.k3",
             (Side::Right, "fx") => "right.fx",
             (Side::Right, "fy") => "right.fy",
             (Side::Right, "cx") => "right.cx",
@@ -181,12 +236,14 @@ impl Side {
             (Side::Right, "k1") => "right.k1",
             (Side::Right, "k2") => "right.k2",
             (Side::Right, "p1") => "right.p1",
-            _ => "right.p2",
+            (Side::Right, "p2") => "right.p2",
+            _ => "right.k3",
         }
     }
 }
 
-/// The calibration of the stereo head: both cameras' intrinsics and the baseline length.
+/// The calibration of the stereo head: both cameras' intrinsics, the baseline length and,
+/// for an unrectified pair, the pose between the cameras.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Calibration {
@@ -194,17 +251,39 @@ pub struct Calibration {
     pub baseline_m: f64,
     pub left: CameraIntrinsics,
     pub right: CameraIntrinsics,
+    /// The pose at calibration time (extension; all zero, and absent from the TOML, for a
+    /// rectified pair).
+    #[serde(default, skip_serializing_if = "Extrinsics::is_zero")]
+    pub extrinsics: Extrinsics,
 }
 
 impl Calibration {
-    /// Reads and validates a calibration file.
+    /// Reads and validates a calibration file in any [`Format`], recognised by content.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, CalibError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|source| CalibError::Io {
             path: path.to_owned(),
             source,
         })?;
-        Self::from_toml_str(&text, path)
+        Self::from_str_any(&text, path)
+    }
+
+    /// Parses and validates a calibration in any [`Format`]; `origin` names the source in
+    /// errors.
+    pub fn from_str_any(text: &str, origin: impl AsRef<Path>) -> Result<Self, CalibError> {
+        let path = origin.as_ref();
+        match Format::detect(text) {
+            Format::Toml => Self::from_toml_str(text, path),
+            Format::OpenCv => opencv::parse(text, path),
+            Format::OpenCvXml => Err(CalibError::Parse {
+                path: path.to_owned(),
+                message: "is OpenCV's XML storage, which is not read: save it as YAML or JSON \
+                          (cv::FileStorage with a .yml or .json name)"
+                    .into(),
+            }),
+            Format::Kalibr => kalibr::parse(text, path),
+            Format::Kitti => kitti::parse(text, path),
+        }
     }
 
     /// Parses and validates calibration TOML; `origin` names the source in errors.
@@ -228,7 +307,15 @@ impl Calibration {
             });
         }
         self.left.validate(path, Side::Left)?;
-        self.right.validate(path, Side::Right)
+        self.right.validate(path, Side::Right)?;
+        match self.extrinsics.too_large() {
+            Some((key, _)) => Err(CalibError::Invalid {
+                path: path.to_owned(),
+                key,
+                reason: "must be finite and within ±45°",
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Serialises to the TOML format `from_toml_str` reads (distortion keys only when non-zero).
