@@ -1,7 +1,7 @@
 //! Thesis fig. 5.2, fixed cameras on a moving vehicle: the verge does not change, so the spread
 //! of the estimate is the system's noise (the thesis: 1.43° to 1.86°, a span of 0.4°). Here the
 //! road scene driven at the scene's own speed with the verge fixed at
-//! [`FIXED_VERGE_DEG`](crate::synth::FIXED_VERGE_DEG), and the renderer's truth to measure the
+//! [`crate::synth::FIXED_VERGE_DEG`], and the renderer's truth to measure the
 //! error the thesis could not (its vehicle head had no encoders).
 //!
 //! Files: `verge.csv`, `verge.png` and `results.csv`.

@@ -145,7 +145,7 @@ impl InProcessLink {
     /// The channels run concurrently. The left one numbers its packets from the link's next
     /// sequence number; the right one's are numbered from 0 and, once the left has finished,
     /// given the numbers that follow the left camera's (in place where the frame allows,
-    /// [`renumber_in_place`], else decoded and sent again through the link's writer): the
+    /// `renumber_in_place`, else decoded and sent again through the link's writer): the
     /// bytes are those of running the two one after the other.
     /// Run one after the other, a left frame refused before its `FrameStart` (a wrong image
     /// size; register errors refuse both alike) would leave the right camera unrun and both

@@ -21,7 +21,7 @@ impl TimedStream for TcpStream {
 
 impl StreamLink<TcpStream> {
     /// Connects to `addr` (e.g. `"127.0.0.1:4444"`), trying each address it resolves to for
-    /// at most [`CONNECT_TIMEOUT`]. Nagle is switched off: register packets are a few bytes
+    /// at most 5 s. Nagle is switched off: register packets are a few bytes
     /// each and the driver waits for every answer.
     pub fn tcp(addr: &str) -> Result<Self, LinkError> {
         let name = format!("tcp {addr}");
