@@ -292,6 +292,10 @@ mod counted {
             self.counted(|fe| fe.push_row(row))
         }
 
+        fn reset(&mut self) {
+            self.counted(|fe| fe.reset())
+        }
+
         fn blank_row(&mut self) -> bool {
             self.counted(|fe| fe.blank_row())
         }
@@ -312,12 +316,20 @@ mod counted {
             self.inner.overflow()
         }
 
+        fn point_level(&self) -> usize {
+            self.inner.point_level()
+        }
+
+        fn sobel_level(&self) -> usize {
+            self.inner.sobel_level()
+        }
+
         fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
             self.inner.drain_points(sink)
         }
 
-        fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-            self.inner.drain_sobel(sink)
+        fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+            self.inner.drain_sobel(max, sink)
         }
     }
 }
