@@ -51,20 +51,6 @@ struct FrameState {
     patches_dropped: u32,
 }
 
-/// The fabric configuration the registers describe, in the model's terms: every register
-/// holds the model's value as is (CONTRAST_THRESHOLD in Q8.8, MAX_OFFSET in raw Q2.13).
-pub fn fabric_config(registers: &FabricConfig) -> Config {
-    Config {
-        width: registers.width,
-        height: registers.height,
-        octaves: registers.octaves,
-        contrast_threshold: registers.contrast_threshold,
-        edge_ratio: registers.edge_ratio,
-        sobel_scale: registers.sobel_scale,
-        max_offset: registers.max_offset,
-    }
-}
-
 /// Drives one camera channel: configures, arms, polls and drains its fabric through the
 /// register map on `B` (offering the frame's pixels on its PIXEL_IN port), and sends what
 /// comes out of the FIFOs as wire packets.
@@ -249,7 +235,7 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
         }
         // What the fabric cannot run (its last octave would be under 3 x 3) is refused here:
         // the RTL does not check the configuration it latches.
-        fabric_config(&registers)
+        Config::from(&registers)
             .validate(octave_widths(W0))
             .map_err(DriverError::FabricConfig)?;
         let drops_before = self.arm()?;

@@ -63,7 +63,7 @@ mod point_batch;
 mod sink;
 mod sobel_ring;
 
-pub use channel::{fabric_config, Driver, FrameSummary, CHANNEL_CAPABILITIES};
+pub use channel::{Driver, FrameSummary, CHANNEL_CAPABILITIES};
 pub use error::{DriverError, ERROR_FRAME_FAILED, ERROR_INVALID_CONFIG, ERROR_UNEXPECTED_KIND};
 pub use patch::MAX_PENDING;
 pub use sink::{ByteSink, PacketWriter};

@@ -905,7 +905,7 @@ fn reference(config: &FabricConfig, image: &[u8]) -> Reference {
             };
         }
     };
-    fe.start_frame(&fabric_config(config)).unwrap();
+    fe.start_frame(&Config::from(config)).unwrap();
     for row in image.chunks_exact(usize::from(config.width)) {
         fe.push_row(row).unwrap();
         drain(&mut fe);
