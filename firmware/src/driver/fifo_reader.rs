@@ -101,34 +101,38 @@ impl FifoReader {
                 *magnitude = sdata::MAGNITUDE.extract(data) as u8;
                 *orientation = sdata::ORIENTATION.extract(data) as u8;
             }
-            let mut run = RunStart {
-                octave: 0,
-                position: 0,
-                start: 0,
-            };
-            let mut last = 0;
-            for (i, entry) in words.chunks_exact(2).take(end).enumerate() {
-                let &[data, position] = entry else {
+            let entries = words.get(..end * 2).unwrap_or_default();
+            let mut start = 0;
+            while let Some(first) = entries.get(start * 2..start * 2 + 2) {
+                let &[data, position] = first else {
                     break;
                 };
-                let octave = sdata::OCTAVE.extract(data) as u8;
-                let follows = octave == run.octave
-                    && position.wrapping_sub(last) == 1
-                    && spos::X.extract(position) != 0;
-                if i == 0 || !follows {
-                    if i > run.start {
-                        on_run(run.of(&self.magnitude, &self.orientation, i))?;
-                    }
-                    run = RunStart {
-                        octave,
-                        position,
-                        start: i,
-                    };
-                }
-                last = position;
-            }
-            if end > run.start {
-                on_run(run.of(&self.magnitude, &self.orientation, end))?;
+                // The run goes on while each entry is the next column of the row, in the same
+                // octave: its position minus its distance from the start stays the start's (a
+                // column wrapping past 0xFFFF would carry into the row, so runs stop short of
+                // it).
+                let octave_bits = data & sdata::OCTAVE.mask();
+                let room = 0x1_0000 - spos::X.extract(position) as usize;
+                let len = entries
+                    .get(start * 2..)
+                    .unwrap_or_default()
+                    .chunks_exact(2)
+                    .take(room)
+                    .enumerate()
+                    .position(|(k, e)| {
+                        let &[d, p] = e else { return true };
+                        d & sdata::OCTAVE.mask() != octave_bits
+                            || p.wrapping_sub(k as u32) != position
+                    })
+                    .unwrap_or_else(|| (end - start).min(room));
+                let run = RunStart {
+                    octave: sdata::OCTAVE.extract(data) as u8,
+                    position,
+                    start,
+                };
+                // `len >= 1`: the first entry is its own run's start.
+                on_run(run.of(&self.magnitude, &self.orientation, start + len.max(1)))?;
+                start += len.max(1);
             }
             if end < n {
                 // An entry read as not VALID: the FIFO was emptied under the drain.
