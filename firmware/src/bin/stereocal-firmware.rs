@@ -43,7 +43,7 @@ mod soft_core {
         FrameInput, InputHeader, FLAG_AUTOSTART, FLAG_COUNT_INSTRUCTIONS, FLAG_REGISTER_MODEL,
         VIRT_FRAME_REGION, VIRT_FRAME_REGION_LEN,
     };
-    use stereocal_firmware::softcore::instructions::{self, CountedFrontEnd, InstructionReport};
+    use stereocal_firmware::softcore::instructions::{self, CountedFabric, InstructionReport};
     use stereocal_firmware::softcore::link::{Uart0, LINK};
     use stereocal_firmware::softcore::stack::{self, StackReport};
     use stereocal_hdl::regs::{control, height, width};
@@ -54,9 +54,9 @@ mod soft_core {
     };
 
     /// One camera channel: the driver, on the registers and PIXEL_IN port of the fabric's
-    /// device model (its datapath's computing counted in instructions). The driver reaches
+    /// device model (everything the model does counted in instructions). The driver reaches
     /// it only through the register bus, as it would reach a fabric's registers by MMIO.
-    type Channel = Driver<FabricDevice<CountedFrontEnd<FabricModel>>>;
+    type Channel = Driver<CountedFabric<FabricDevice<FabricModel>>>;
 
     /// Host packets are short (a RegisterWrite is 16 framed bytes); a longer frame is refused.
     type HostAccumulator = Accumulator<64>;
@@ -93,13 +93,13 @@ mod soft_core {
 
     /// A channel for `camera` whose WIDTH/HEIGHT match the input frames.
     fn channel(header: &InputHeader, camera: Camera) -> Channel {
-        let model = CountedFrontEnd::new(if header.has_flag(FLAG_REGISTER_MODEL) {
+        let model = if header.has_flag(FLAG_REGISTER_MODEL) {
             FabricModel::register_level()
         } else {
             FabricModel::fast()
-        });
-        let mut channel =
-            Driver::new(FabricDevice::new(model), camera).with_capabilities(Capabilities::LOG);
+        };
+        let fabric = CountedFabric::new(FabricDevice::new(model));
+        let mut channel = Driver::new(fabric, camera).with_capabilities(Capabilities::LOG);
         let bus = channel.bus_mut();
         let geometry = bus
             .write_field(&width::VALUE, header.width.into())
@@ -206,7 +206,7 @@ mod soft_core {
                     // `FrameInput::new` checked that every image is in the region.
                     stop(ExitCode::BadInput);
                 };
-                channel.bus().datapath().take();
+                channel.bus().take();
                 with_link(|link| link.sink_mut().take_waited());
                 let start = instructions::instret();
                 let result =
@@ -214,7 +214,7 @@ mod soft_core {
                 let spent = instructions::instret().wrapping_sub(start);
                 match result {
                     Ok(summary) if header.has_flag(FLAG_COUNT_INSTRUCTIONS) => {
-                        let front_end = channel.bus().datapath().take();
+                        let front_end = channel.bus().take();
                         let uart_wait = with_link(|link| link.sink_mut().take_waited());
                         instructions::log(&InstructionReport {
                             frame: summary.frame_id,

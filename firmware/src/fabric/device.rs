@@ -139,11 +139,6 @@ impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
         }
     }
 
-    /// The datapath behind the registers.
-    pub fn datapath(&self) -> &F {
-        &self.datapath
-    }
-
     /// Whether PIXEL_IN takes a pixel now.
     fn ready(&mut self) -> bool {
         matches!(self.phase, Phase::AwaitSof | Phase::Run) && self.registers.control_enable()
