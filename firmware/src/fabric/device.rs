@@ -17,7 +17,7 @@
 //!   SOFT_RESET, saturating); FRAME_COUNT counts frames done (wrapping); LATENCY_CLOCKS below.
 //! - A read of POINT_FIFO_DATA or SOBEL_FIFO_DATA pops the head and loads the holding
 //!   registers (POINT_FIFO_DXDY, POINT_FIFO_DSDOG, SOBEL_FIFO_POSITION); on an empty FIFO it
-//!   reads 0 (VALID clear) and zeroes them. [`fifo_words`] has the layout.
+//!   reads 0 (VALID clear) and zeroes them. [`crate::fabric::fifo_words`] has the layout.
 //! - Offsets inside the window address their word, whatever their low two bits (the RTL
 //!   decodes `addr[7:2]`); offsets outside it, and words no register occupies, read 0 and
 //!   ignore writes.
