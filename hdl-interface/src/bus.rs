@@ -14,6 +14,20 @@ pub trait RegisterBus {
     /// Writes the register at `offset`.
     fn write(&mut self, offset: u16, value: u32);
 
+    /// Reads `words.len()` registers in one burst, cycling through `offsets`:
+    /// `words[i] = read(offsets[i % offsets.len()])`, in that order (nothing when `offsets`
+    /// is empty).
+    ///
+    /// This is how FIFO entries are drained: `[DATA, POSITION]` repeated N times pops N Sobel
+    /// entries and reads each one's holding register right after its pop. The provided loop
+    /// is what an MMIO bus does (one volatile load per word); a software device overrides it
+    /// to serve the burst without a call per word.
+    fn read_burst(&mut self, offsets: &[u16], words: &mut [u32]) {
+        for (word, &offset) in words.iter_mut().zip(offsets.iter().cycle()) {
+            *word = self.read(offset);
+        }
+    }
+
     /// Reads one field. Reading a [`crate::Register::pops_on_read`] register has its side
     /// effect.
     fn read_field(&mut self, field: &Field) -> u32 {
@@ -53,6 +67,10 @@ impl<B: RegisterBus + ?Sized> RegisterBus for &mut B {
     fn write(&mut self, offset: u16, value: u32) {
         (**self).write(offset, value)
     }
+
+    fn read_burst(&mut self, offsets: &[u16], words: &mut [u32]) {
+        (**self).read_burst(offsets, words)
+    }
 }
 
 #[cfg(test)]
@@ -87,6 +105,23 @@ mod tests {
             writes: [None; 4],
             count: 0,
         }
+    }
+
+    #[test]
+    fn a_burst_cycles_through_its_offsets() {
+        struct Echo;
+        impl RegisterBus for Echo {
+            fn read(&mut self, offset: u16) -> u32 {
+                offset.into()
+            }
+            fn write(&mut self, _offset: u16, _value: u32) {}
+        }
+        let mut words = [0; 5];
+        Echo.read_burst(&[0x48, 0x4C], &mut words);
+        assert_eq!(words, [0x48, 0x4C, 0x48, 0x4C, 0x48]);
+        let mut untouched = [7; 2];
+        Echo.read_burst(&[], &mut untouched);
+        assert_eq!(untouched, [7, 7]);
     }
 
     #[test]

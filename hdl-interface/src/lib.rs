@@ -8,7 +8,8 @@
 //!   implemented for every [`RegisterBus`].
 //! - [`RegisterBus`] (hand-written) is the transport under it, 32-bit reads and writes at
 //!   byte offsets; [`Mmio`] implements it on the soft-core, [`RegisterBank`] in memory for the
-//!   fabric model and for tests.
+//!   fabric model and for tests. [`RegisterBus::read_burst`] drains a FIFO in one call.
+//! - [`PixelIn`] is the PIXEL_IN stream port, for a program that feeds the frames itself.
 //! - [`FabricConfig`] is the typed, validated configuration the driver writes and the model
 //!   reads.
 #![no_std]
@@ -21,6 +22,7 @@ mod config;
 mod error;
 mod field;
 mod mmio;
+mod pixel_in;
 mod register;
 // Generated; rustfmt would only fight the generator.
 #[rustfmt::skip]
@@ -36,5 +38,6 @@ pub use config::FabricConfig;
 pub use error::Error;
 pub use field::Field;
 pub use mmio::Mmio;
+pub use pixel_in::PixelIn;
 pub use register::{register_at, Register};
 pub use regs_api::Registers;

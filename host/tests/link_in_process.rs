@@ -7,8 +7,7 @@ use std::time::Duration;
 use stereocal::driver::{Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame};
 use stereocal::frame::Gradients;
 use stereocal::link::{InProcessLink, Link};
-use stereocal_firmware::driver::fabric_config;
-use stereocal_firmware::fabric::{run_frame, Extremum, FastFrontEnd, SobelPixel, SobelRun};
+use stereocal_firmware::fabric::{run_frame, Config, Extremum, FastFrontEnd, SobelPixel, SobelRun};
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hdl::FabricConfig;
 use stereocal_wire::{Camera, ErrorCode};
@@ -68,7 +67,7 @@ fn reference(config: &FabricConfig, image: &[u8]) -> (Vec<Extremum>, Vec<SobelPi
     let (mut points, mut sobel) = (Vec::new(), Vec::new());
     run_frame(
         fe.as_mut(),
-        &fabric_config(config),
+        &Config::from(config),
         image,
         &mut |p: &[Extremum]| points.extend_from_slice(p),
         &mut |s: SobelRun<'_>| sobel.extend(s.pixels()),

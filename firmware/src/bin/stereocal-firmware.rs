@@ -9,7 +9,7 @@
 //!    stream is byte for byte what the in-process device sends (apart from the `LOG`
 //!    capability bit in that `Hello`).
 //! 3. For every frame of the input, left then right image: the driver runs the image through
-//!    the fabric model and sends its packets. Host packets waiting between frames are
+//!    the fabric's device model, on its registers and PIXEL_IN port, and sends its packets. Host packets waiting between frames are
 //!    answered; clearing `CONTROL.ENABLE` pauses before the next frame. With
 //!    `FLAG_COUNT_INSTRUCTIONS` each image's instruction counts follow as a log packet, and
 //!    after the last frame the row kernels' counts on the first image
@@ -36,25 +36,27 @@ fn main() {
 
 #[cfg(target_os = "none")]
 mod soft_core {
-    use stereocal_firmware::driver::{Driver, DriverError, FabricModel, PacketWriter};
+    use stereocal_firmware::driver::{Driver, DriverError, PacketWriter};
+    use stereocal_firmware::fabric::{FabricDevice, FabricModel};
     use stereocal_firmware::softcore::finisher::{self, ExitCode};
     use stereocal_firmware::softcore::frame_input::{
         FrameInput, InputHeader, FLAG_AUTOSTART, FLAG_COUNT_INSTRUCTIONS, FLAG_REGISTER_MODEL,
         VIRT_FRAME_REGION, VIRT_FRAME_REGION_LEN,
     };
-    use stereocal_firmware::softcore::instructions::{self, CountedFrontEnd, InstructionReport};
+    use stereocal_firmware::softcore::instructions::{self, CountedFabric, InstructionReport};
     use stereocal_firmware::softcore::link::{Uart0, LINK};
     use stereocal_firmware::softcore::stack::{self, StackReport};
     use stereocal_hdl::regs::{control, height, width};
-    use stereocal_hdl::{RegisterBank, RegisterBus};
+    use stereocal_hdl::RegisterBus;
     use stereocal_wire::{
         Accumulator, Camera, Capabilities, ErrorCode, ErrorReportRepr, FeedResult, HelloRepr,
         PacketRepr, PROTOCOL_VERSION,
     };
 
-    /// One camera channel: the model's registers, the model (its computing counted in
-    /// instructions), the driver.
-    type Channel = Driver<RegisterBank, CountedFrontEnd<FabricModel>>;
+    /// One camera channel: the driver, on the registers and PIXEL_IN port of the fabric's
+    /// device model (everything the model does counted in instructions). The driver reaches
+    /// it only through the register bus, as it would reach a fabric's registers by MMIO.
+    type Channel = Driver<CountedFabric<FabricDevice<FabricModel>>>;
 
     /// Host packets are short (a RegisterWrite is 16 framed bytes); a longer frame is refused.
     type HostAccumulator = Accumulator<64>;
@@ -91,13 +93,13 @@ mod soft_core {
 
     /// A channel for `camera` whose WIDTH/HEIGHT match the input frames.
     fn channel(header: &InputHeader, camera: Camera) -> Channel {
-        let model = CountedFrontEnd::new(if header.has_flag(FLAG_REGISTER_MODEL) {
+        let model = if header.has_flag(FLAG_REGISTER_MODEL) {
             FabricModel::register_level()
         } else {
             FabricModel::fast()
-        });
-        let mut channel =
-            Driver::new(RegisterBank::new(), model, camera).with_capabilities(Capabilities::LOG);
+        };
+        let fabric = CountedFabric::new(FabricDevice::new(model));
+        let mut channel = Driver::new(fabric, camera).with_capabilities(Capabilities::LOG);
         let bus = channel.bus_mut();
         let geometry = bus
             .write_field(&width::VALUE, header.width.into())
@@ -204,7 +206,7 @@ mod soft_core {
                     // `FrameInput::new` checked that every image is in the region.
                     stop(ExitCode::BadInput);
                 };
-                channel.fabric().take();
+                channel.bus().take();
                 with_link(|link| link.sink_mut().take_waited());
                 let start = instructions::instret();
                 let result =
@@ -212,7 +214,7 @@ mod soft_core {
                 let spent = instructions::instret().wrapping_sub(start);
                 match result {
                     Ok(summary) if header.has_flag(FLAG_COUNT_INSTRUCTIONS) => {
-                        let front_end = channel.fabric().take();
+                        let front_end = channel.bus().take();
                         let uart_wait = with_link(|link| link.sink_mut().take_waited());
                         instructions::log(&InstructionReport {
                             frame: summary.frame_id,

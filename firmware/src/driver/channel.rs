@@ -1,7 +1,7 @@
 //! The driver of one camera channel: its fabric, its registers, its frame counter.
 
 use stereocal_hdl::regs::output_mode::SobelOutput;
-use stereocal_hdl::{register_at, FabricConfig, RegisterBus};
+use stereocal_hdl::{register_at, FabricConfig, PixelIn, RegisterBus, Registers};
 use stereocal_wire::{
     Camera, Capabilities, ErrorCode, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr,
     HelloRepr, PacketRepr, PointBatchRepr, Records, RegisterValueRepr, SobelPatchRepr, SobelPixel,
@@ -9,11 +9,13 @@ use stereocal_wire::{
 };
 
 use crate::driver::error::{DriverError, ERROR_UNEXPECTED_KIND};
+use crate::driver::fifo_reader::FifoReader;
 use crate::driver::patch::{PatchQueue, PendingPatch, HALF};
 use crate::driver::point_batch::{wire_point, PointBatch};
 use crate::driver::sink::{ByteSink, PacketWriter};
 use crate::driver::sobel_ring::{Completed, SobelRing};
-use crate::fabric::{Config, Extremum, FrameError, FrontEnd, Overflow, SobelRun};
+use crate::fabric::config::MAX_OCTAVES;
+use crate::fabric::{Config, Extremum, FrameError, Overflow, SobelRun};
 
 /// What a channel can send, as announced in its `Hello`.
 pub const CHANNEL_CAPABILITIES: Capabilities = Capabilities(
@@ -49,36 +51,24 @@ struct FrameState {
     patches_dropped: u32,
 }
 
-/// The fabric configuration the registers describe, in the model's terms: every register
-/// holds the model's value as is (CONTRAST_THRESHOLD in Q8.8, MAX_OFFSET in raw Q2.13).
-pub fn fabric_config(registers: &FabricConfig) -> Config {
-    Config {
-        width: registers.width,
-        height: registers.height,
-        octaves: registers.octaves,
-        contrast_threshold: registers.contrast_threshold,
-        edge_ratio: registers.edge_ratio,
-        sobel_scale: registers.sobel_scale,
-        max_offset: registers.max_offset,
-    }
-}
-
-/// Drives one camera channel: configures its fabric through `B`, runs frames through `F`, and
-/// sends what comes out of the FIFOs as wire packets.
+/// Drives one camera channel: configures, arms, polls and drains its fabric through the
+/// register map on `B` (offering the frame's pixels on its PIXEL_IN port), and sends what
+/// comes out of the FIFOs as wire packets.
 ///
+/// `B` is [`stereocal_hdl::Mmio`] next to a real fabric or a
+/// [`crate::fabric::FabricDevice`] in software; the driver's code path is the same.
 /// `W0` is the widest frame the driver's Sobel ring holds (the fabric's octave-0 line length).
 /// The driver is large (the ring holds 32 rows per octave); on the host, box it.
-pub struct Driver<B: RegisterBus, F: FrontEnd, const W0: usize = 1280> {
+pub struct Driver<B: RegisterBus + PixelIn, const W0: usize = 1280> {
     bus: B,
-    fabric: F,
     capabilities: Capabilities,
     next_frame_id: u32,
+    reader: FifoReader,
     output: FrameOutput<W0>,
 }
 
-/// Everything of a channel but its bus and fabric: what turns the fabric's streams into
-/// packets. Kept apart from the fabric so the fabric can hand its Sobel FIFO over in bulk
-/// (`drain_sobel`) to a callback that borrows this part mutably.
+/// Everything of a channel but its fabric and FIFO buffers: what turns the fabric's streams
+/// into packets. Kept apart so a drain can hand it the entries it pops.
 struct FrameOutput<const W0: usize> {
     camera: Camera,
     frame: FrameState,
@@ -88,15 +78,15 @@ struct FrameOutput<const W0: usize> {
     patch: [SobelPixel; PATCH_PIXELS],
 }
 
-impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
-    /// A driver for `camera`'s fabric, reached through `bus` (its registers) and `fabric` (its
-    /// pixel input and FIFOs). The first frame is number 0.
-    pub fn new(bus: B, fabric: F, camera: Camera) -> Self {
+impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
+    /// A driver for `camera`'s fabric, reached through `bus` (its registers and PIXEL_IN).
+    /// The first frame is number 0.
+    pub fn new(bus: B, camera: Camera) -> Self {
         Self {
             bus,
-            fabric,
             capabilities: CHANNEL_CAPABILITIES,
             next_frame_id: 0,
+            reader: FifoReader::new(),
             output: FrameOutput {
                 camera,
                 frame: FrameState {
@@ -131,19 +121,14 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         self.next_frame_id
     }
 
-    /// The register bus.
+    /// The fabric's bus.
     pub fn bus(&self) -> &B {
         &self.bus
     }
 
-    /// The register bus, mutably.
+    /// The fabric's bus, mutably.
     pub fn bus_mut(&mut self) -> &mut B {
         &mut self.bus
-    }
-
-    /// The fabric.
-    pub fn fabric(&self) -> &F {
-        &self.fabric
     }
 
     /// Validates `config` and writes it to the fabric's registers.
@@ -203,10 +188,31 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
     /// configuration its registers hold, and sends FrameStart, the frame's PointBatch and
     /// SobelRows/SobelPatch packets (as OUTPUT_MODE.SOBEL_OUTPUT says), then FrameEnd.
     ///
+    /// The fabric takes the frame's pixels with CONTROL.ENABLE set; the driver sets it for
+    /// the frame and leaves it as it found it, since ENABLE is also the host's "start" (a head
+    /// waits for it before grabbing).
+    ///
     /// An error before FrameStart sends nothing and leaves the frame number unused; an error
     /// after it leaves the frame without a FrameEnd (the caller reports the error) and its
     /// number used up.
     pub fn process_frame<S: ByteSink>(
+        &mut self,
+        image: &[u8],
+        timestamp_us: u64,
+        out: &mut PacketWriter<S>,
+    ) -> Result<FrameSummary, DriverError> {
+        let enabled = self.bus.control_enable();
+        let result = self.run_frame(image, timestamp_us, out);
+        if !enabled {
+            self.bus
+                .set_control_enable(false)
+                .map_err(DriverError::Registers)?;
+        }
+        result
+    }
+
+    /// [`Self::process_frame`] but for restoring CONTROL.ENABLE.
+    fn run_frame<S: ByteSink>(
         &mut self,
         image: &[u8],
         timestamp_us: u64,
@@ -227,10 +233,12 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
                 got: image.len(),
             });
         }
-        let config = fabric_config(&registers);
-        self.fabric
-            .start_frame(&config)
+        // What the fabric cannot run (its last octave would be under 3 x 3) is refused here:
+        // the RTL does not check the configuration it latches.
+        Config::from(&registers)
+            .validate(octave_widths(W0))
             .map_err(DriverError::FabricConfig)?;
+        let drops_before = self.arm()?;
         self.output
             .ring
             .start(registers.width, registers.height, registers.octaves);
@@ -259,14 +267,15 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         )?;
         // `read_from` validated WIDTH >= MIN_SIDE; `max(1)` only lets the compiler see that
         // `chunks_exact` cannot be handed 0 (its one panic).
-        for row in image.chunks_exact(width.max(1)) {
-            self.fabric.push_row(row).map_err(DriverError::Frame)?;
+        for (y, row) in image.chunks_exact(width.max(1)).enumerate() {
+            self.bus.push(row, y == 0);
             self.drain(out)?;
         }
         let mut flushed = false;
         for _ in 0..flush_rows(registers.height) {
-            flushed = self.fabric.blank_row();
+            self.bus.idle(registers.width.into());
             self.drain(out)?;
+            flushed = !self.bus.status_busy();
             if flushed {
                 break;
             }
@@ -282,7 +291,7 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         }
         self.output.send_points(out)?;
 
-        let overflow = self.fabric.overflow();
+        let overflow = self.drops().since(drops_before);
         let dropped_sobel = overflow
             .sobel
             .saturating_add(self.output.frame.patches_dropped);
@@ -314,22 +323,47 @@ impl<B: RegisterBus, F: FrontEnd, const W0: usize> Driver<B, F, W0> {
         })
     }
 
+    /// Arms the fabric for a frame: first clears what an abandoned frame left (the frame
+    /// still running, entries in the FIFOs) with a soft reset, then enables PIXEL_IN and fires
+    /// FRAME_ARM. Returns the drop counters before the frame.
+    fn arm(&mut self) -> Result<Overflow, DriverError> {
+        let bus = &mut self.bus;
+        if bus.status_busy()
+            || bus.point_fifo_level_level() != 0
+            || bus.sobel_fifo_level_level() != 0
+        {
+            bus.fire_control_soft_reset()
+                .map_err(DriverError::Registers)?;
+        }
+        let drops = self.drops();
+        let bus = &mut self.bus;
+        bus.set_control_enable(true)
+            .and_then(|()| bus.fire_control_frame_arm())
+            .map_err(DriverError::Registers)?;
+        if !bus.status_busy() {
+            return Err(DriverError::NotArmed);
+        }
+        Ok(drops)
+    }
+
+    /// The fabric's drop counters (since its last reset).
+    fn drops(&mut self) -> Overflow {
+        Overflow {
+            points: self.bus.point_overflow_count_count(),
+            sobel: self.bus.sobel_overflow_count_count(),
+        }
+    }
+
     /// Empties both FIFOs, points first.
     fn drain<S: ByteSink>(&mut self, out: &mut PacketWriter<S>) -> Result<(), DriverError> {
-        while let Some(point) = self.fabric.pop_point() {
-            self.output.on_point(&point, out)?;
-        }
-        // In bulk, so the ring can take runs of a row at once. A run handed over after an
-        // error is dropped unread: the frame is abandoned anyway, and the next one starts by
-        // clearing the FIFOs.
-        let mut result = Ok(());
-        let output = &mut self.output;
-        self.fabric.drain_sobel(&mut |run| {
-            if result.is_ok() {
-                result = output.on_sobel(run, out);
-            }
-        });
-        result
+        let Self {
+            bus,
+            reader,
+            output,
+            ..
+        } = self;
+        reader.drain_points(bus, &mut |point| output.on_point(point, out))?;
+        reader.drain_sobel(bus, &mut |run| output.on_sobel(run, out))
     }
 }
 
@@ -497,6 +531,11 @@ impl<const W0: usize> FrameOutput<W0> {
         self.batch.clear();
         Ok(())
     }
+}
+
+/// Line lengths of the octaves of a fabric whose octave 0 holds `w0` pixels.
+fn octave_widths(w0: usize) -> [usize; MAX_OCTAVES] {
+    [w0, w0.div_ceil(2), w0.div_ceil(4), w0.div_ceil(8)]
 }
 
 /// Blank rows after the last input row within which the fabric must have emitted everything:

@@ -57,6 +57,8 @@ pub enum DriverError {
     /// A packet could not be encoded (a driver defect: every packet is built within the wire
     /// format's limits).
     Encode(stereocal_wire::Error),
+    /// The fabric did not take FRAME_ARM: STATUS.BUSY stayed 0.
+    NotArmed,
 }
 
 impl DriverError {
@@ -87,6 +89,7 @@ impl DriverError {
             Self::SobelOutOfOrder(p) => (6, u32::from(p.y)),
             Self::PointOutOfFrame { y, .. } => (7, u32::from(y)),
             Self::Encode(_) => (8, 0),
+            Self::NotArmed => (9, 0),
         };
         (variant << 24) | value
     }
@@ -132,6 +135,7 @@ impl fmt::Display for DriverError {
                 "fabric emitted point ({x}, {y}) outside octave {octave}'s image"
             ),
             Self::Encode(e) => write!(f, "packet encoding: {e}"),
+            Self::NotArmed => write!(f, "the fabric did not take FRAME_ARM (STATUS.BUSY stayed 0)"),
         }
     }
 }

@@ -1,16 +1,18 @@
-//! The soft-core driver: configures the fabric through its registers, feeds it frames, and
-//! turns its point and Sobel FIFOs into wire packets.
+//! The soft-core driver: configures the fabric through its registers, offers it frames on
+//! PIXEL_IN, and turns its point and Sobel FIFOs into wire packets.
 //!
-//! One [`Driver`] per camera channel. It is generic over the register bus
-//! ([`stereocal_hdl::RegisterBus`]: the in-memory [`stereocal_hdl::RegisterBank`] next to the
-//! model, [`stereocal_hdl::Mmio`] on an FPGA) and the front end ([`crate::fabric::FrontEnd`]:
-//! [`FabricModel`] picks the fast path or the register-level model at run time), and writes
-//! into any [`ByteSink`] through a [`PacketWriter`] that numbers the packets. The same code
-//! runs in the soft-core ELF and in the host's in-process link:
+//! One [`Driver`] per camera channel. It speaks to the fabric only through the register map
+//! (the generated [`stereocal_hdl::Registers`] API and FIFO bursts of
+//! [`stereocal_hdl::RegisterBus::read_burst`]) and its PIXEL_IN port
+//! ([`stereocal_hdl::PixelIn`]), so it is generic over what implements those:
+//! [`stereocal_hdl::Mmio`] on an FPGA, the device model [`crate::fabric::FabricDevice`] in
+//! software (in the soft-core ELF under QEMU and in the host's in-process link). It writes
+//! into any [`ByteSink`] through a [`PacketWriter`] that numbers the packets:
 //!
 //! ```
-//! use stereocal_firmware::driver::{ByteSink, Driver, FabricModel, PacketWriter};
-//! use stereocal_hdl::{FabricConfig, RegisterBank};
+//! use stereocal_firmware::driver::{ByteSink, Driver, PacketWriter};
+//! use stereocal_firmware::fabric::{FabricDevice, FabricModel};
+//! use stereocal_hdl::FabricConfig;
 //! use stereocal_wire::Camera;
 //!
 //! struct Collect(Vec<u8>);
@@ -20,8 +22,9 @@
 //!     }
 //! }
 //!
-//! let mut driver: Box<Driver<RegisterBank, FabricModel<64, 32, 16, 12>, 64>> =
-//!     Box::new(Driver::new(RegisterBank::new(), FabricModel::fast(), Camera::Left));
+//! type Fabric = FabricDevice<FabricModel<64, 32, 16, 12>, 64>;
+//! let mut driver: Box<Driver<Fabric, 64>> =
+//!     Box::new(Driver::new(FabricDevice::new(FabricModel::fast()), Camera::Left));
 //! let config = FabricConfig { width: 64, height: 32, octaves: 2, ..FabricConfig::default() };
 //! driver.configure(&config)?;
 //! let mut link = PacketWriter::new(Collect(Vec::new()));
@@ -31,6 +34,14 @@
 //! // link.sink().0 now holds FrameStart, the frame's packets and FrameEnd, COBS-framed.
 //! # Ok::<(), stereocal_firmware::driver::DriverError>(())
 //! ```
+//!
+//! # A frame on the registers
+//! The configuration registers are read back and validated; a frame an earlier error left
+//! running (or entries it left in the FIFOs) is cleared with CONTROL.SOFT_RESET; the drop
+//! counters are read; CONTROL.ENABLE and FRAME_ARM start the frame (STATUS.BUSY must rise).
+//! Each image row is offered on PIXEL_IN (SOF on the first) and both FIFOs drained; then
+//! blanking line times, each followed by a drain, until STATUS.BUSY falls. The frame's drops
+//! are the counters' growth since arming.
 //!
 //! # Packets of a frame
 //! `FrameStart`; then, as the FIFOs are drained after every input row and blanking row,
@@ -46,15 +57,14 @@
 
 mod channel;
 mod error;
-mod front_end;
+mod fifo_reader;
 mod patch;
 mod point_batch;
 mod sink;
 mod sobel_ring;
 
-pub use channel::{fabric_config, Driver, FrameSummary, CHANNEL_CAPABILITIES};
+pub use channel::{Driver, FrameSummary, CHANNEL_CAPABILITIES};
 pub use error::{DriverError, ERROR_FRAME_FAILED, ERROR_INVALID_CONFIG, ERROR_UNEXPECTED_KIND};
-pub use front_end::FabricModel;
 pub use patch::MAX_PENDING;
 pub use sink::{ByteSink, PacketWriter};
 pub use sobel_ring::{OutOfOrder, RING_ROWS};

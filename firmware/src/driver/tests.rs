@@ -1,5 +1,7 @@
-//! Driver tests on the host: the in-memory register bank, a scripted front end that emits
-//! exactly the points and Sobel pixels a test needs, and the real fast path.
+//! Driver tests on the host, on the register path: the driver drives the fabric's device model
+//! ([`FabricDevice`]) through its registers and PIXEL_IN, over a scripted datapath that emits
+//! exactly the points and Sobel pixels a test needs, or over the real fast path and
+//! register-level model.
 
 extern crate std;
 
@@ -8,7 +10,7 @@ use std::vec;
 use std::vec::Vec;
 
 use stereocal_hdl::regs::output_mode::SobelOutput;
-use stereocal_hdl::{regs, FabricConfig, RegisterBank, RegisterBus};
+use stereocal_hdl::{register_at, regs, FabricConfig, PixelIn, RegisterBus};
 use stereocal_wire::{
     decode, Camera, ErrorCode, FrameEndFlags, Header, HelloRepr, PacketRepr, Point,
     RegisterReadRepr, RegisterWriteRepr, SobelPixel, PATCH_PIXELS,
@@ -19,8 +21,8 @@ use crate::fabric::geometry::octave_dims;
 use crate::fabric::refine::Offset;
 use crate::fabric::sobel_fifo::SobelFifo;
 use crate::fabric::{
-    Config, ConfigError, Extremum, FrameError, FrontEnd, Overflow, SobelPixel as FabricSobel,
-    SobelRun,
+    Config, ConfigError, Extremum, FabricDevice, FabricModel, FrameError, FrontEnd, Overflow,
+    SobelPixel as FabricSobel, SobelRun,
 };
 
 /// A sink that keeps every byte.
@@ -181,11 +183,15 @@ impl FrontEnd for Scripted {
         self.config = Some(*config);
         self.rows_in = 0;
         self.blank_rows = 0;
-        self.overflow = Overflow {
-            points: self.dropped_points,
-            sobel: 0,
-        };
+        self.overflow.points += self.dropped_points;
         Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.config = None;
+        self.point_fifo.clear();
+        self.sobel_fifo.clear();
+        self.overflow = Overflow::default();
     }
 
     fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError> {
@@ -241,6 +247,14 @@ impl FrontEnd for Scripted {
         self.overflow
     }
 
+    fn point_level(&self) -> usize {
+        self.point_fifo.len()
+    }
+
+    fn sobel_level(&self) -> usize {
+        self.sobel_fifo.len()
+    }
+
     fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
         let (a, b) = self.point_fifo.as_slices();
         sink(a);
@@ -248,18 +262,65 @@ impl FrontEnd for Scripted {
         self.point_fifo.clear();
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
+    fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        let n = max.min(self.sobel_fifo.len());
         self.sobel_fifo
-            .iter()
-            .for_each(|p| sink(SobelRun::single(p)));
-        self.sobel_fifo.clear();
+            .drain(..n)
+            .for_each(|p| sink(SobelRun::single(&p)));
     }
 }
 
-type ScriptedDriver = Driver<RegisterBank, Scripted, 64>;
+type ScriptedDriver = Driver<Watched<FabricDevice<Scripted, 64>>, 64>;
+
+/// A fabric's bus as an MMIO bus is: every burst read word by word. It also counts accesses to
+/// offsets where no register lives.
+struct Watched<D> {
+    device: D,
+    unmapped: u32,
+}
+
+impl<D> Watched<D> {
+    fn new(device: D) -> Self {
+        Self {
+            device,
+            unmapped: 0,
+        }
+    }
+
+    fn watch(&mut self, offset: u16) {
+        if offset % 4 != 0 || register_at(offset).is_none() {
+            self.unmapped += 1;
+        }
+    }
+}
+
+impl<D: RegisterBus> RegisterBus for Watched<D> {
+    fn read(&mut self, offset: u16) -> u32 {
+        self.watch(offset);
+        self.device.read(offset)
+    }
+
+    fn write(&mut self, offset: u16, value: u32) {
+        self.watch(offset);
+        self.device.write(offset, value)
+    }
+}
+
+impl<D: PixelIn> PixelIn for Watched<D> {
+    fn push(&mut self, pixels: &[u8], start_of_frame: bool) {
+        self.device.push(pixels, start_of_frame)
+    }
+
+    fn idle(&mut self, clocks: u32) {
+        self.device.idle(clocks)
+    }
+}
 
 fn scripted_driver(script: Scripted, config: &FabricConfig) -> std::boxed::Box<ScriptedDriver> {
-    let mut driver = std::boxed::Box::new(Driver::new(RegisterBank::new(), script, Camera::Right));
+    let mut driver = std::boxed::Box::new(Driver::new(
+        Watched::new(FabricDevice::new(script)),
+        Camera::Right,
+    ));
     driver.configure(config).expect("valid configuration");
     driver
 }
@@ -676,7 +737,7 @@ fn host_packets_are_answered() {
         ]
     );
     assert_eq!(
-        driver.bus().bus_errors(),
+        driver.bus().unmapped,
         0,
         "unmapped addresses never reach the bus"
     );
@@ -733,6 +794,9 @@ fn a_fabric_emitting_out_of_order_is_an_error() {
             }
             Ok(())
         }
+        fn reset(&mut self) {
+            self.0.reset()
+        }
         fn blank_row(&mut self) -> bool {
             self.0.blank_row()
         }
@@ -748,16 +812,21 @@ fn a_fabric_emitting_out_of_order_is_an_error() {
         fn overflow(&self) -> Overflow {
             self.0.overflow()
         }
+        fn point_level(&self) -> usize {
+            self.0.point_level()
+        }
+        fn sobel_level(&self) -> usize {
+            self.0.sobel_level()
+        }
         fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
             self.0.drain_points(sink)
         }
-        fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-            self.0.drain_sobel(sink)
+        fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+            self.0.drain_sobel(max, sink)
         }
     }
-    let mut driver: Driver<RegisterBank, Backwards, 64> = Driver::new(
-        RegisterBank::new(),
-        Backwards(Scripted::default()),
+    let mut driver: Driver<FabricDevice<Backwards, 64>, 64> = Driver::new(
+        FabricDevice::new(Backwards(Scripted::default())),
         Camera::Left,
     );
     driver.configure(&SMALL).unwrap();
@@ -836,7 +905,7 @@ fn reference(config: &FabricConfig, image: &[u8]) -> Reference {
             };
         }
     };
-    fe.start_frame(&fabric_config(config)).unwrap();
+    fe.start_frame(&Config::from(config)).unwrap();
     for row in image.chunks_exact(usize::from(config.width)) {
         fe.push_row(row).unwrap();
         drain(&mut fe);
@@ -881,10 +950,9 @@ fn fast_path_points_and_patches_match_its_sobel_images() {
     let image = blob_image(160, 120, 11);
     let reference = reference(&TEXTURED, &image);
     assert!(reference.points.len() >= 10, "the test image has features");
-    let mut driver: std::boxed::Box<Driver<RegisterBank, FabricModel<160, 80, 40, 20>, 160>> =
+    let mut driver: std::boxed::Box<Driver<FabricDevice<FabricModel<160, 80, 40, 20>, 160>, 160>> =
         std::boxed::Box::new(Driver::new(
-            RegisterBank::new(),
-            FabricModel::fast(),
+            FabricDevice::new(FabricModel::fast()),
             Camera::Left,
         ));
     driver.configure(&TEXTURED).unwrap();
@@ -942,10 +1010,9 @@ fn fast_path_rows_are_its_sobel_images() {
     };
     let image = blob_image(160, 120, 5);
     let reference = reference(&config, &image);
-    let mut driver: std::boxed::Box<Driver<RegisterBank, FabricModel<160, 80, 40, 20>, 160>> =
+    let mut driver: std::boxed::Box<Driver<FabricDevice<FabricModel<160, 80, 40, 20>, 160>, 160>> =
         std::boxed::Box::new(Driver::new(
-            RegisterBank::new(),
-            FabricModel::fast(),
+            FabricDevice::new(FabricModel::fast()),
             Camera::Left,
         ));
     driver.configure(&config).unwrap();
@@ -1027,8 +1094,8 @@ fn register_level_model_sends_the_same_records_as_the_fast_path() {
         FabricModel::<64, 32, 16, 12>::fast(),
         FabricModel::register_level(),
     ] {
-        let mut driver: std::boxed::Box<Driver<RegisterBank, FabricModel<64, 32, 16, 12>, 64>> =
-            std::boxed::Box::new(Driver::new(RegisterBank::new(), model, Camera::Left));
+        let mut driver: std::boxed::Box<Driver<FabricDevice<FabricModel<64, 32, 16, 12>, 64>, 64>> =
+            std::boxed::Box::new(Driver::new(FabricDevice::new(model), Camera::Left));
         driver.configure(&config).unwrap();
         let mut link = PacketWriter::new(Collect::default());
         let summary = driver.process_frame(&image, 0, &mut link).unwrap();
@@ -1038,74 +1105,32 @@ fn register_level_model_sends_the_same_records_as_the_fast_path() {
     assert_eq!(results[0], results[1]);
 }
 
-/// A front end that hands its Sobel FIFO over in runs of one pixel: the driver then stores
-/// every pixel on its own, as the per-pixel path did before runs were copied as blocks.
-struct OnePixelAtATime<F>(F);
-
-impl<F: FrontEnd> FrontEnd for OnePixelAtATime<F> {
-    fn start_frame(&mut self, c: &Config) -> Result<(), ConfigError> {
-        self.0.start_frame(c)
-    }
-    fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError> {
-        self.0.push_row(row)
-    }
-    fn blank_row(&mut self) -> bool {
-        self.0.blank_row()
-    }
-    fn frame_done(&self) -> bool {
-        self.0.frame_done()
-    }
-    fn pop_point(&mut self) -> Option<Extremum> {
-        self.0.pop_point()
-    }
-    fn pop_sobel(&mut self) -> Option<FabricSobel> {
-        self.0.pop_sobel()
-    }
-    fn overflow(&self) -> Overflow {
-        self.0.overflow()
-    }
-    fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
-        self.0.drain_points(sink)
-    }
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        self.0.drain_sobel(&mut |mut run| {
-            while !run.is_empty() {
-                let (pixel, rest) = run.split_at(1);
-                sink(pixel);
-                run = rest;
-            }
-        })
-    }
-}
-
-/// The bytes `fabric` makes a driver send for `image`.
-fn wire_bytes<F: FrontEnd, const W0: usize>(
-    fabric: F,
+/// The bytes a driver on `fabric` sends for `image`.
+fn wire_bytes<D: RegisterBus + PixelIn, const W0: usize>(
+    fabric: D,
     config: &FabricConfig,
     image: &[u8],
 ) -> Vec<u8> {
-    let mut driver: std::boxed::Box<Driver<RegisterBank, F, W0>> =
-        std::boxed::Box::new(Driver::new(RegisterBank::new(), fabric, Camera::Left));
+    let mut driver: std::boxed::Box<Driver<D, W0>> =
+        std::boxed::Box::new(Driver::new(fabric, Camera::Left));
     driver.configure(config).unwrap();
     let mut link = PacketWriter::new(Collect::default());
     driver.process_frame(image, 0, &mut link).unwrap();
     link.sink().0.clone()
 }
 
+/// The device's bursts serve the words a word-by-word bus reads, so the bytes are the same.
 #[test]
-fn sobel_runs_stored_as_blocks_send_the_same_bytes_as_pixel_by_pixel() {
+fn bursts_send_the_same_bytes_as_word_by_word_reads() {
     let image = blob_image(160, 120, 5);
     for mode in [SobelOutput::Rows, SobelOutput::Patches] {
         let config = FabricConfig {
             sobel_output: mode,
             ..TEXTURED
         };
-        let bulk = wire_bytes::<_, 160>(FabricModel::<160, 80, 40, 20>::fast(), &config, &image);
-        let single = wire_bytes::<_, 160>(
-            OnePixelAtATime(FabricModel::<160, 80, 40, 20>::fast()),
-            &config,
-            &image,
-        );
+        let fast = || FabricDevice::<_, 160>::new(FabricModel::<160, 80, 40, 20>::fast());
+        let bulk = wire_bytes::<_, 160>(fast(), &config, &image);
+        let single = wire_bytes::<_, 160>(Watched::new(fast()), &config, &image);
         assert_eq!(bulk, single, "{mode:?}");
 
         // Dropped pixels: at a row's start, inside it, at its end, and whole rows.
@@ -1122,8 +1147,9 @@ fn sobel_runs_stored_as_blocks_send_the_same_bytes_as_pixel_by_pixel() {
             ..Scripted::default()
         };
         let image = vec![0u8; 48 * 40];
-        let bulk = wire_bytes::<_, 64>(script(), &config, &image);
-        let single = wire_bytes::<_, 64>(OnePixelAtATime(script()), &config, &image);
+        let device = || FabricDevice::<_, 64>::new(script());
+        let bulk = wire_bytes::<_, 64>(device(), &config, &image);
+        let single = wire_bytes::<_, 64>(Watched::new(device()), &config, &image);
         assert_eq!(bulk, single, "{mode:?}, dropped pixels");
     }
 }
@@ -1175,7 +1201,7 @@ fn push_run_reports_what_pixel_by_pixel_pushes_report() {
     let mut got = Vec::new();
     let mut next = 0;
     let mut queued = 0;
-    fifo.drain(&mut |mut run| {
+    fifo.drain(usize::MAX, &mut |mut run| {
         queued += 1;
         while !run.is_empty() {
             match runs.push_run(&run) {

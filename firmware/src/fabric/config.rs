@@ -1,11 +1,15 @@
 //! Run-time configuration of the front end: what the soft-core writes into the register map
-//! before a frame. The driver fills [`Config`] from registers; the model checks it against the
-//! memories it was built with ([`Config::validate`]).
+//! before a frame. The fabric latches [`Config`] from its registers (a driver's validated
+//! [`FabricConfig`] converts with `From`); the model checks it against the register map's
+//! ranges and the memories it was built with ([`Config::validate`]).
+
+use stereocal_hdl::regs::{self, max_offset, octaves, output_mode};
+use stereocal_hdl::FabricConfig;
 
 use crate::fabric::geometry::octave_dims;
 
-/// Number of octaves the fabric has memories for.
-pub const MAX_OCTAVES: usize = 4;
+/// Number of octaves the fabric has memories for: the register map's `max_octaves`.
+pub const MAX_OCTAVES: usize = regs::MAX_OCTAVES as usize;
 
 /// Front-end configuration (one register each in the register map).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,16 +45,20 @@ impl Config {
         }
     }
 
-    /// Checks the configuration against a front end whose octave `k` has memories for
-    /// `max_widths[k]` pixels per row.
+    /// Checks the configuration against the register map's ranges (OCTAVES.COUNT,
+    /// OUTPUT_MODE.SOBEL_SCALE, MAX_OFFSET.VALUE) and a front end whose octave `k` has
+    /// memories for `max_widths[k]` pixels per row.
     pub fn validate(&self, max_widths: [usize; MAX_OCTAVES]) -> Result<(), ConfigError> {
-        if self.octaves == 0 || self.octaves as usize > MAX_OCTAVES {
+        if octaves::COUNT.check(self.octaves.into()).is_err() {
             return Err(ConfigError::Octaves(self.octaves));
         }
-        if self.sobel_scale > 3 {
+        if output_mode::SOBEL_SCALE
+            .check(self.sobel_scale.into())
+            .is_err()
+        {
             return Err(ConfigError::SobelScale(self.sobel_scale));
         }
-        if self.max_offset > 8191 {
+        if max_offset::VALUE.check(self.max_offset.into()).is_err() {
             return Err(ConfigError::MaxOffset(self.max_offset));
         }
         if self.width as usize > max_widths[0] {
@@ -68,6 +76,22 @@ impl Config {
             });
         }
         Ok(())
+    }
+}
+
+/// The configuration the registers describe, in the model's terms: every register holds the
+/// model's value as is (CONTRAST_THRESHOLD in Q8.8, MAX_OFFSET in raw Q2.13).
+impl From<&FabricConfig> for Config {
+    fn from(registers: &FabricConfig) -> Self {
+        Self {
+            width: registers.width,
+            height: registers.height,
+            octaves: registers.octaves,
+            contrast_threshold: registers.contrast_threshold,
+            edge_ratio: registers.edge_ratio,
+            sobel_scale: registers.sobel_scale,
+            max_offset: registers.max_offset,
+        }
     }
 }
 

@@ -59,7 +59,10 @@ pub const fn sample_clock(width: u16, height: u16, k: u8, n: u32) -> u64 {
     }
     let (w, _) = octave_dims(width, height, k);
     let (pw, ph) = octave_dims(width, height, k - 1);
-    let (x, y) = (n % w as u32, n / w as u32);
+    // An empty octave (a zero-width frame, which no configuration allows) has no samples.
+    let (Some(x), Some(y)) = (n.checked_rem(w as u32), n.checked_div(w as u32)) else {
+        return 0;
+    };
     let parent = 2 * y * pw as u32 + 2 * x;
     let e = parent + octave_to_next(pw, k - 1);
     let parent_total = pw as u32 * ph as u32;
@@ -72,7 +75,7 @@ pub const fn sample_clock(width: u16, height: u16, k: u8, n: u32) -> u64 {
 
 /// First pixel in to first pixel of the last of `octaves` octaves, in clocks.
 pub const fn first_pixel_of_last_octave(width: u16, height: u16, octaves: u8) -> u64 {
-    sample_clock(width, height, octaves - 1, 0)
+    sample_clock(width, height, octaves.saturating_sub(1), 0)
 }
 
 /// The same in nanoseconds at `clock_hz`.

@@ -1,6 +1,9 @@
 //! The FPGA front end ("fabric"), modelled stage by stage.
 //!
-//! Two implementations produce bit-identical outputs behind one trait, [`FrontEnd`]:
+//! [`FabricDevice`] is the fabric as a program sees it, `sc_fabric` behind its register map
+//! and PIXEL_IN port ([`device`]). Its datapath is one of two implementations producing
+//! bit-identical outputs behind one trait, [`FrontEnd`] ([`FabricModel`] picks one at run
+//! time):
 //! - [`RegisterFrontEnd`]: the register-level model, one [`RegisterFrontEnd::clock`] per pixel
 //!   with explicit pipeline registers, line memories and the hardware's bit widths. It is the
 //!   specification the RTL must match clock for clock.
@@ -25,15 +28,18 @@
 pub mod config;
 pub mod convolver;
 pub mod cordic;
+pub mod device;
 pub mod dog;
 pub mod edge;
 pub mod extrema;
 pub mod fast;
 pub mod fifo;
+pub mod fifo_words;
 pub mod geometry;
 pub mod latency;
 pub mod linebuffer;
 pub mod memory;
+pub mod model;
 pub mod octave;
 pub mod output;
 pub mod pipeline;
@@ -46,7 +52,9 @@ pub mod taps;
 pub mod window;
 
 pub use config::{Config, ConfigError};
+pub use device::FabricDevice;
 pub use fast::FastFrontEnd;
+pub use model::FabricModel;
 pub use output::{run_frame, Extremum, FrameError, FrontEnd, Overflow, SobelPixel};
 pub use pipeline::RegisterFrontEnd;
 pub use probe::{ClockProbe, OctaveProbe};

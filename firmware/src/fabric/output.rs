@@ -2,14 +2,16 @@
 //! with overflow counters, and the [`FrontEnd`] trait both implementations share.
 //!
 //! # Driver contract
-//! 1. `start_frame(&config)` (register writes + frame start).
+//! 0. `reset()` (SOFT_RESET) empties the FIFOs and zeroes the drop counters.
+//! 1. `start_frame(&config)` (register writes + FRAME_ARM): restarts the datapath; the FIFOs
+//!    and counters keep what they hold, as in the RTL.
 //! 2. For each input row: `push_row(&row)`, then drain both FIFOs (`pop_point`, `pop_sobel`
 //!    until `None`). One input row produces at most `2·W0` Sobel pixels and the Sobel FIFO
 //!    holds `3·W0`, so draining after every row never overflows.
 //! 3. Vertical blanking: `blank_row()` (one row time of clocks without pixels) and drain, until
 //!    it returns `true` (every octave has emitted everything).
 //! 4. `overflow()` tells how many items were dropped because the driver fell behind; the
-//!    counters are never reset silently (`start_frame` clears them, so read them first).
+//!    counters are never reset silently (only `reset` clears them).
 //!
 //! Within one octave both streams come in raster order; the octaves are interleaved in an
 //! implementation-defined way (the register-level model interleaves them by clock, the fast
@@ -77,8 +79,24 @@ pub struct Overflow {
     pub sobel: u32,
 }
 
-/// Capacity of the point FIFO.
-pub const POINT_FIFO_CAPACITY: usize = 512;
+impl Overflow {
+    /// What these counters counted since they read `before` (the counters only grow between
+    /// resets, so the difference is the drops in between).
+    pub fn since(self, before: Self) -> Self {
+        Self {
+            points: self.points.wrapping_sub(before.points),
+            sobel: self.sobel.wrapping_sub(before.sobel),
+        }
+    }
+}
+
+/// Capacity of the point FIFO: the register map's `point_fifo_depth`.
+pub const POINT_FIFO_CAPACITY: usize = stereocal_hdl::regs::POINT_FIFO_DEPTH as usize;
+
+// The point FIFO is 8 line memories of 64 entries (`OutputFifos::points`), the Sobel FIFO 3
+// lines of octave 0: at the map's widest line that is the map's `sobel_fifo_depth`.
+const _: () = assert!(POINT_FIFO_CAPACITY == 64 * 8);
+const _: () = assert!(3 * stereocal_hdl::regs::MAX_WIDTH == stereocal_hdl::regs::SOBEL_FIFO_DEPTH);
 
 /// The two output FIFOs of a front end whose octave 0 is at most `W0` wide.
 #[derive(Clone, Debug)]
@@ -150,9 +168,10 @@ impl<const W0: usize> OutputFifos<W0> {
         self.points.drain_slices(sink);
     }
 
-    /// Hands all queued Sobel pixels to `sink` in row runs and empties the FIFO.
-    pub fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        self.sobel.drain(sink);
+    /// Hands the oldest `max` queued Sobel pixels (all, if fewer) to `sink` in row runs and
+    /// removes them.
+    pub fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        self.sobel.drain(max, sink);
     }
 
     /// Oldest point.
@@ -170,6 +189,16 @@ impl<const W0: usize> OutputFifos<W0> {
     /// Drop counters.
     pub fn overflow(&self) -> Overflow {
         self.overflow
+    }
+
+    /// Points held.
+    pub fn point_level(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Sobel pixels held.
+    pub fn sobel_level(&self) -> usize {
+        self.sobel.len()
     }
 }
 
@@ -211,8 +240,11 @@ impl core::fmt::Display for FrameError {
 /// ([`crate::fabric::pipeline::RegisterFrontEnd`]) and the fast path
 /// ([`crate::fabric::fast::FastFrontEnd`]). Both produce bit-identical streams.
 pub trait FrontEnd {
-    /// Configures and starts a frame; clears the FIFOs and counters.
+    /// Configures the datapath and starts a frame. The FIFOs and the drop counters keep what
+    /// they hold (FRAME_ARM in the RTL restarts the datapath, not the FIFOs).
     fn start_frame(&mut self, config: &Config) -> Result<(), ConfigError>;
+    /// Stops the frame, empties both FIFOs and zeroes the drop counters (SOFT_RESET).
+    fn reset(&mut self);
     /// Feeds one row of 8-bit grey pixels.
     fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError>;
     /// One row time of vertical blanking; `true` once the frame is completely processed.
@@ -223,18 +255,22 @@ pub trait FrontEnd {
     fn pop_point(&mut self) -> Option<Extremum>;
     /// Oldest pixel of the Sobel FIFO.
     fn pop_sobel(&mut self) -> Option<SobelPixel>;
-    /// Items dropped so far this frame.
+    /// Items dropped since the last [`FrontEnd::reset`] (saturating).
     fn overflow(&self) -> Overflow;
+    /// Entries waiting in the point FIFO.
+    fn point_level(&self) -> usize;
+    /// Entries waiting in the Sobel FIFO.
+    fn sobel_level(&self) -> usize;
     /// Hands every queued point to `sink`, oldest first, in at most two slices.
     fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum]));
-    /// Hands every queued Sobel pixel to `sink`, oldest first, in runs of consecutive pixels
-    /// of one row.
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>));
+    /// Hands the oldest `max` queued Sobel pixels (all, if fewer) to `sink`, oldest first, in
+    /// runs of consecutive pixels of one row, and removes them.
+    fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>));
 }
 
 /// Runs a whole `config.width x config.height` frame through `fe`, draining the FIFOs after
 /// every row into the two callbacks (slices of consecutive points and runs of Sobel pixels,
-/// oldest first). Returns the overflow counters.
+/// oldest first). Resets `fe` first; returns the frame's overflow counters.
 pub fn run_frame<F: FrontEnd + ?Sized>(
     fe: &mut F,
     config: &Config,
@@ -249,10 +285,11 @@ pub fn run_frame<F: FrontEnd + ?Sized>(
             got: image.len(),
         });
     }
+    fe.reset();
     fe.start_frame(config).map_err(FrameError::Config)?;
     let mut drain = |fe: &mut F| {
         fe.drain_points(on_points);
-        fe.drain_sobel(on_sobel);
+        fe.drain_sobel(usize::MAX, on_sobel);
     };
     for row in image.chunks_exact(w) {
         fe.push_row(row)?;

@@ -153,7 +153,6 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.o1.start(config);
         self.o2.start(config);
         self.o3.start(config);
-        self.fifos.clear();
         self.config = Some(*config);
         self.rows_in = 0;
         self.clock = 0;
@@ -196,6 +195,15 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.rows_in == cfg.height && self.octaves_done()
     }
 
+    fn reset(&mut self) {
+        self.fifos.clear();
+        self.config = None;
+        self.rows_in = 0;
+        self.clock = 0;
+        self.first_input = [None; MAX_OCTAVES];
+        self.probe = ClockProbe::IDLE;
+    }
+
     fn pop_point(&mut self) -> Option<Extremum> {
         self.fifos.pop_point()
     }
@@ -208,11 +216,19 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.fifos.overflow()
     }
 
+    fn point_level(&self) -> usize {
+        self.fifos.point_level()
+    }
+
+    fn sobel_level(&self) -> usize {
+        self.fifos.sobel_level()
+    }
+
     fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
         self.fifos.drain_points(sink);
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        self.fifos.drain_sobel(sink);
+    fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        self.fifos.drain_sobel(max, sink);
     }
 }

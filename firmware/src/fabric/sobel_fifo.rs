@@ -250,32 +250,41 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
         Some(pixel)
     }
 
-    /// Hands every queued run to `sink`, oldest first, and empties the FIFO.
-    pub fn drain(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        let (magnitude, orientation) = (
-            self.magnitude.as_flattened(),
-            self.orientation.as_flattened(),
-        );
-        let mut at = self.head;
-        for k in 0..self.run_count {
-            let Some(run) = self.runs.as_flattened().get(Self::wrap(self.run_head + k)) else {
+    /// Hands the oldest `max` queued pixels (all of them, if fewer) to `sink` in runs, oldest
+    /// first, and removes them.
+    pub fn drain(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        let mut left = max.min(self.len);
+        while left > 0 && self.run_count > 0 {
+            // Runs never straddle the end of the ring (`push_run` splits them there).
+            let Some(run) = self.runs.as_flattened_mut().get_mut(self.run_head) else {
                 break;
             };
-            let len = usize::from(run.len);
-            let (Some(m), Some(o)) = (magnitude.get(at..at + len), orientation.get(at..at + len))
-            else {
+            let n = usize::from(run.len).min(left);
+            let at = self.head;
+            let (Some(magnitude), Some(orientation)) = (
+                self.magnitude.as_flattened().get(at..at + n),
+                self.orientation.as_flattened().get(at..at + n),
+            ) else {
                 break;
             };
             sink(SobelRun {
                 octave: run.octave,
                 y: run.y,
                 x: run.x,
-                magnitude: m,
-                orientation: o,
+                magnitude,
+                orientation,
             });
-            at = Self::wrap(at + len);
+            // `n <= run.len`, a u16.
+            run.x = run.x.wrapping_add(n as u16);
+            run.len -= n as u16;
+            if run.len == 0 {
+                self.run_head = Self::wrap(self.run_head + 1);
+                self.run_count -= 1;
+            }
+            self.head = Self::wrap(self.head + n);
+            self.len -= n;
+            left -= n;
         }
-        self.clear();
     }
 }
 
@@ -364,7 +373,7 @@ mod tests {
                     Step::Pop => prop_assert_eq!(runs.pop(), records.pop()),
                     Step::Drain => {
                         let mut from_runs = Vec::new();
-                        runs.drain(&mut |run| {
+                        runs.drain(usize::MAX, &mut |run| {
                             assert!(!run.is_empty());
                             from_runs.extend(run.pixels());
                         });

@@ -2,10 +2,11 @@
 //!
 //! The fabric does the front end in hardware; this module measures what the same work would
 //! cost as software on the soft-core, the thesis' table 4.4 question asked of our code. On the
-//! bare-metal target `CountedFrontEnd` wraps the fabric model and adds up the `minstret`
-//! deltas of `start_frame`, `push_row` and `blank_row` (the fabric's computation); draining
-//! the FIFOs stays with the driver, because the soft-core reads those FIFOs on the real head
-//! too. The UART sink counts its waits for the transmitter apart (`link::Uart0`). Under
+//! bare-metal target `CountedFabric` wraps the fabric's device model and adds up the
+//! `minstret` deltas of every register access and every call of its PIXEL_IN port: the
+//! datapath's computation and the model's side of the bus, which is hardware on the real head.
+//! What stays with the driver is its own work around each access (on a board, the load or
+//! store itself). The UART sink counts its waits for the transmitter apart (`link::Uart0`). Under
 //! QEMU `-icount shift=0`, `minstret` counts retired instructions exactly, so the front-end
 //! count is the same on every run. The UART wait depends on how fast the host reads, and the
 //! driver's count carries the few instructions around each wait, so it varies by a few
@@ -131,7 +132,7 @@ impl KernelReport {
 }
 
 #[cfg(target_os = "none")]
-pub use counted::{instret, log, log_kernels, measure_kernels, CountedFrontEnd};
+pub use counted::{instret, log, log_kernels, measure_kernels, CountedFabric};
 
 #[cfg(target_os = "none")]
 mod counted {
@@ -141,9 +142,7 @@ mod counted {
     use super::{InstructionReport, KernelReport};
     use crate::fabric::fast::{column_filter, cordic_row, dog_row, row_filter, sobel_row};
     use crate::fabric::taps::GAUSS_TAPS;
-    use crate::fabric::{
-        Config, ConfigError, Extremum, FrameError, FrontEnd, Overflow, SobelPixel, SobelRun,
-    };
+    use stereocal_hdl::{PixelIn, RegisterBus};
 
     /// Widest row [`measure_kernels`] takes: the fabric's octave-0 line length.
     const MAX_WIDTH: usize = 1280;
@@ -250,18 +249,18 @@ mod counted {
         Some(report)
     }
 
-    /// A front end whose computing calls are counted in instructions.
+    /// A fabric whose every register access and PIXEL_IN call is counted in instructions.
     ///
-    /// The count is a `Cell` so it can be taken through the driver's shared `fabric()`
-    /// accessor, the only one it has.
-    pub struct CountedFrontEnd<F> {
-        inner: F,
+    /// The count is a `Cell` so it can be taken through the driver's shared `bus()`
+    /// accessor.
+    pub struct CountedFabric<D> {
+        inner: D,
         instructions: Cell<u64>,
     }
 
-    impl<F> CountedFrontEnd<F> {
+    impl<D> CountedFabric<D> {
         /// Wraps `inner`; the count starts at 0.
-        pub const fn new(inner: F) -> Self {
+        pub const fn new(inner: D) -> Self {
             Self {
                 inner,
                 instructions: Cell::new(0),
@@ -273,7 +272,7 @@ mod counted {
             self.instructions.take()
         }
 
-        fn counted<R>(&mut self, f: impl FnOnce(&mut F) -> R) -> R {
+        fn counted<R>(&mut self, f: impl FnOnce(&mut D) -> R) -> R {
             let start = instret();
             let result = f(&mut self.inner);
             let spent = instret().wrapping_sub(start);
@@ -283,41 +282,27 @@ mod counted {
         }
     }
 
-    impl<F: FrontEnd> FrontEnd for CountedFrontEnd<F> {
-        fn start_frame(&mut self, config: &Config) -> Result<(), ConfigError> {
-            self.counted(|fe| fe.start_frame(config))
+    impl<D: RegisterBus> RegisterBus for CountedFabric<D> {
+        fn read(&mut self, offset: u16) -> u32 {
+            self.counted(|d| d.read(offset))
         }
 
-        fn push_row(&mut self, row: &[u8]) -> Result<(), FrameError> {
-            self.counted(|fe| fe.push_row(row))
+        fn write(&mut self, offset: u16, value: u32) {
+            self.counted(|d| d.write(offset, value))
         }
 
-        fn blank_row(&mut self) -> bool {
-            self.counted(|fe| fe.blank_row())
+        fn read_burst(&mut self, offsets: &[u16], words: &mut [u32]) {
+            self.counted(|d| d.read_burst(offsets, words))
+        }
+    }
+
+    impl<D: PixelIn> PixelIn for CountedFabric<D> {
+        fn push(&mut self, pixels: &[u8], start_of_frame: bool) {
+            self.counted(|d| d.push(pixels, start_of_frame))
         }
 
-        fn frame_done(&self) -> bool {
-            self.inner.frame_done()
-        }
-
-        fn pop_point(&mut self) -> Option<Extremum> {
-            self.inner.pop_point()
-        }
-
-        fn pop_sobel(&mut self) -> Option<SobelPixel> {
-            self.inner.pop_sobel()
-        }
-
-        fn overflow(&self) -> Overflow {
-            self.inner.overflow()
-        }
-
-        fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
-            self.inner.drain_points(sink)
-        }
-
-        fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-            self.inner.drain_sobel(sink)
+        fn idle(&mut self, clocks: u32) {
+            self.counted(|d| d.idle(clocks))
         }
     }
 }

@@ -1,4 +1,4 @@
-//! The device inside the host: the firmware's soft-core driver and fabric model, one channel
+//! The device inside the host: the firmware's soft-core driver on the fabric's device model, one channel
 //! per camera, called synchronously.
 //!
 //! This is the default link of `stereocal run/eval/demo`: the same firmware code as the ELF,
@@ -18,11 +18,11 @@
 use std::time::Instant;
 
 use stereocal_firmware::driver::{
-    ByteSink, Driver as Channel, DriverError as ChannelError, FabricModel, FrameSummary,
-    PacketWriter,
+    ByteSink, Driver as Channel, DriverError as ChannelError, FrameSummary, PacketWriter,
 };
+use stereocal_firmware::fabric::{FabricDevice, FabricModel};
 use stereocal_hdl::regs::control;
-use stereocal_hdl::{RegisterBank, RegisterBus};
+use stereocal_hdl::RegisterBus;
 use stereocal_wire::{decode, Accumulator, Camera, FeedResult, PacketRepr, MAX_FRAME_LEN};
 
 use super::renumber::renumber_in_place;
@@ -31,8 +31,9 @@ use super::{Link, LinkError};
 /// Name in errors.
 const NAME: &str = "in-process";
 
-/// One camera's channel at the fabric's full size (1280-pixel lines).
-type FullChannel = Channel<RegisterBank, FabricModel, 1280>;
+/// One camera's channel at the fabric's full size (1280-pixel lines): the firmware's driver on
+/// the registers of the fabric's device model.
+type FullChannel = Channel<FabricDevice<FabricModel>, 1280>;
 
 /// The device's output, waiting for the host to read it.
 #[derive(Debug, Default)]
@@ -243,7 +244,7 @@ fn boxed_channel(
     let builder = std::thread::Builder::new()
         .name("in-process channel".into())
         .stack_size(BUILD_STACK);
-    let build = move || Box::new(Channel::new(RegisterBank::new(), model(), camera));
+    let build = move || Box::new(Channel::new(FabricDevice::new(model()), camera));
     builder
         .spawn(build)
         .map_err(|e| LinkError::Device(format!("cannot start the {camera:?} channel: {e}")))?

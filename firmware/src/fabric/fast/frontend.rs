@@ -153,7 +153,6 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.o1.start(config);
         self.o2.start(config);
         self.o3.start(config);
-        self.fifos.clear();
         self.config = Some(*config);
         self.rows_in = 0;
         Ok(())
@@ -177,6 +176,12 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
             && (n < 4 || self.o3.done())
     }
 
+    fn reset(&mut self) {
+        self.fifos.clear();
+        self.config = None;
+        self.rows_in = 0;
+    }
+
     fn pop_point(&mut self) -> Option<Extremum> {
         self.fifos.pop_point()
     }
@@ -189,11 +194,19 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.fifos.overflow()
     }
 
+    fn point_level(&self) -> usize {
+        self.fifos.point_level()
+    }
+
+    fn sobel_level(&self) -> usize {
+        self.fifos.sobel_level()
+    }
+
     fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
         self.fifos.drain_points(sink);
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        self.fifos.drain_sobel(sink);
+    fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        self.fifos.drain_sobel(max, sink);
     }
 }

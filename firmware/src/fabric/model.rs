@@ -1,9 +1,9 @@
-//! A front end chosen at run time: the fast path (the default) or the register-level model.
+//! A datapath chosen at run time: the fast path (the default) or the register-level model.
 //!
 //! Both produce the same points and Sobel pixels; the register-level model is the clock-level
 //! specification of the RTL and is much slower, so the soft-core and the host run the fast
-//! path unless asked otherwise. The two interleave their octaves differently, so the packets
-//! of a frame come in a different order (same contents per row, patch and point).
+//! path unless asked otherwise. The two interleave their octaves differently, so the FIFOs
+//! (and the packets of a frame) hold the same entries per octave in a different order.
 
 use crate::fabric::{
     Config, ConfigError, Extremum, FastFrontEnd, FrameError, FrontEnd, Overflow, RegisterFrontEnd,
@@ -68,6 +68,10 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.front_end().push_row(row)
     }
 
+    fn reset(&mut self) {
+        self.front_end().reset()
+    }
+
     fn blank_row(&mut self) -> bool {
         self.front_end().blank_row()
     }
@@ -79,10 +83,9 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         }
     }
 
-    // The driver pops points one at a time, as the soft-core reads the FIFO register: matched
-    // here rather than through `front_end()`, so each pop is a direct call the compiler can
-    // inline into the driver's loop instead of a virtual one. (It takes Sobel pixels in bulk
-    // through `drain_sobel`: one virtual call per row run.)
+    // The device pops entries one at a time, as the soft-core reads the FIFO registers:
+    // matched here rather than through `front_end()`, so each pop is a direct call the
+    // compiler can inline into the device's loop instead of a virtual one.
     fn pop_point(&mut self) -> Option<Extremum> {
         match self {
             Self::Fast(fe) => fe.pop_point(),
@@ -91,7 +94,10 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
     }
 
     fn pop_sobel(&mut self) -> Option<SobelPixel> {
-        self.front_end().pop_sobel()
+        match self {
+            Self::Fast(fe) => fe.pop_sobel(),
+            Self::RegisterLevel(fe) => fe.pop_sobel(),
+        }
     }
 
     fn overflow(&self) -> Overflow {
@@ -101,11 +107,25 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         }
     }
 
+    fn point_level(&self) -> usize {
+        match self {
+            Self::Fast(fe) => fe.point_level(),
+            Self::RegisterLevel(fe) => fe.point_level(),
+        }
+    }
+
+    fn sobel_level(&self) -> usize {
+        match self {
+            Self::Fast(fe) => fe.sobel_level(),
+            Self::RegisterLevel(fe) => fe.sobel_level(),
+        }
+    }
+
     fn drain_points(&mut self, sink: &mut dyn FnMut(&[Extremum])) {
         self.front_end().drain_points(sink)
     }
 
-    fn drain_sobel(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        self.front_end().drain_sobel(sink)
+    fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        self.front_end().drain_sobel(max, sink)
     }
 }

@@ -1,0 +1,414 @@
+//! The fabric as a device: `sc_fabric` (`hdl-interface/rtl/sc_fabric.v`) in software, behind
+//! the register map ([`RegisterBus`]) and the PIXEL_IN port ([`PixelIn`]).
+//!
+//! A program drives [`FabricDevice`] exactly as it drives the RTL: it writes the
+//! configuration registers, arms a frame with CONTROL.FRAME_ARM, offers pixels on PIXEL_IN,
+//! polls STATUS and drains the FIFOs by reading POINT_FIFO_* and SOBEL_FIFO_*. Behind the
+//! registers sits any datapath ([`FrontEnd`]): the register-level model, the fast path,
+//! [`crate::fabric::FabricModel`] choosing between them at run time, or a test's script.
+//!
+//! # Registers, as `sc_regs` and `sc_fabric` define them
+//! - `rw` configuration lives in a [`RegisterBank`]: the map's masks and reset values, so
+//!   reserved bits read 0 and a write keeps only the field bits.
+//! - VERSION reads its constant; CONTROL reads ENABLE (its `wo` strobes read 0).
+//! - STATUS: BUSY from the frame state; FRAME_DONE, POINT_OVERFLOW and SOBEL_OVERFLOW are
+//!   sticky, set by the device and cleared by writing 1 (`w1c`) or by SOFT_RESET.
+//! - FIFO levels and overflow counters are the datapath's FIFOs' (counters since the last
+//!   SOFT_RESET, saturating); FRAME_COUNT counts frames done (wrapping); LATENCY_CLOCKS below.
+//! - A read of POINT_FIFO_DATA or SOBEL_FIFO_DATA pops the head and loads the holding
+//!   registers (POINT_FIFO_DXDY, POINT_FIFO_DSDOG, SOBEL_FIFO_POSITION); on an empty FIFO it
+//!   reads 0 (VALID clear) and zeroes them. [`crate::fabric::fifo_words`] has the layout.
+//! - Offsets inside the window address their word, whatever their low two bits (the RTL
+//!   decodes `addr[7:2]`); offsets outside it, and words no register occupies, read 0 and
+//!   ignore writes.
+//!
+//! # Frame control, as `sc_fabric`'s state machine
+//! Idle, then (FRAME_ARM, ignored while BUSY; SOFT_RESET in the same write wins) armed:
+//! the configuration registers are latched into the datapath and BUSY rises. PIXEL_IN is
+//! ready while CONTROL.ENABLE is 1 and the frame still takes pixels; pixels offered when it is
+//! not ready are lost, and pixels before the first one with SOF are discarded. The SOF pixel
+//! is pixel (0, 0) and the frame is the next WIDTH x HEIGHT pixels (lines are counted by
+//! WIDTH; EOL is not checked). After its last pixel the datapath flushes on blanking clocks
+//! until it has emitted everything: BUSY falls, FRAME_DONE is set and FRAME_COUNT counts it.
+//! SOFT_RESET empties both FIFOs, stops the frame and clears STATUS, the counters, the
+//! latency and the holding registers; the configuration registers keep their values.
+//!
+//! # Time
+//! The device has no clock of its own: a clock passes for every pixel offered while a frame
+//! runs and for every idle clock of [`PixelIn::idle`]; register accesses fall between clocks.
+//! The datapath is fed whole lines (a line offered in pieces is gathered first), and the
+//! blanking clocks after a frame's last pixel reach it a line time (WIDTH clocks) at a time,
+//! since the fast path works by lines; idle clocks inside a frame only delay it.
+//! LATENCY_CLOCKS is the clock, counted from the frame's first pixel, at which the last
+//! configured octave takes its first input: the register-level model's figure
+//! ([`latency::first_pixel_of_last_octave`], checked against the model's clocks by
+//! `tests/latency.rs`), stored once that many clocks have passed.
+//!
+//! What a program can observe therefore matches the RTL register for register, but not clock
+//! for clock: when the FIFOs fill within a line, and (with the fast path) the order in which
+//! octaves interleave their entries, follow the datapath's granularity.
+
+use stereocal_hdl::regs::{
+    control, frame_count, latency_clocks, point_fifo_data, point_fifo_dsdog, point_fifo_dxdy,
+    point_fifo_level, point_overflow_count, sobel_fifo_data, sobel_fifo_level, sobel_fifo_position,
+    sobel_overflow_count, status, version, WINDOW_SIZE,
+};
+use stereocal_hdl::{PixelIn, RegisterBank, RegisterBus, Registers};
+
+use crate::fabric::config::Config;
+use crate::fabric::fifo_words::{point_words, sobel_run_words, sobel_words, SOBEL_OFFSETS};
+use crate::fabric::latency;
+use crate::fabric::output::{FrontEnd, Overflow};
+
+/// Where the frame is (`sc_fabric`'s `state`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// No frame: BUSY is 0.
+    Idle,
+    /// Armed, waiting for the SOF pixel.
+    AwaitSof,
+    /// Taking the frame's pixels.
+    Run,
+    /// Every pixel in; the datapath drains on blanking clocks.
+    Flush,
+}
+
+/// The frame being taken: what FRAME_ARM latched.
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    width: u16,
+    /// WIDTH x HEIGHT.
+    total: u32,
+    /// Pixels taken so far.
+    taken: u32,
+    /// Clocks since the first pixel (the first pixel is clock 0).
+    clock: u64,
+    /// LATENCY_CLOCKS of this frame, until it is stored.
+    latency: Option<u64>,
+    /// Blanking clocks not yet handed to the datapath (less than a line).
+    blank: u32,
+}
+
+/// `sc_fabric` in software over the datapath `F`; `W0` is the longest line it gathers (the
+/// datapath's octave-0 line length).
+#[derive(Clone, Debug)]
+pub struct FabricDevice<F, const W0: usize = 1280> {
+    datapath: F,
+    registers: RegisterBank,
+    phase: Phase,
+    frame: Frame,
+    /// The line being gathered from PIXEL_IN.
+    line: [u8; W0],
+    line_len: usize,
+    /// STATUS's sticky flags, in their bit positions.
+    flags: u32,
+    /// The datapath's drop counters when the flags last looked at them.
+    drops_seen: Overflow,
+    frame_count: u32,
+    latency: u32,
+    /// POINT_FIFO_DXDY and POINT_FIFO_DSDOG.
+    point_hold: [u32; 2],
+    /// SOBEL_FIFO_POSITION.
+    sobel_hold: u32,
+}
+
+impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
+    /// The device after power-up: registers at their reset values, no frame, empty FIFOs.
+    pub fn new(mut datapath: F) -> Self {
+        datapath.reset();
+        Self {
+            datapath,
+            registers: RegisterBank::new(),
+            phase: Phase::Idle,
+            frame: Frame {
+                width: 0,
+                total: 0,
+                taken: 0,
+                clock: 0,
+                latency: None,
+                blank: 0,
+            },
+            line: [0; W0],
+            line_len: 0,
+            flags: 0,
+            drops_seen: Overflow::default(),
+            frame_count: 0,
+            latency: 0,
+            point_hold: [0; 2],
+            sobel_hold: 0,
+        }
+    }
+
+    /// Whether PIXEL_IN takes a pixel now.
+    fn ready(&mut self) -> bool {
+        matches!(self.phase, Phase::AwaitSof | Phase::Run) && self.registers.control_enable()
+    }
+
+    /// FRAME_ARM while idle: latches the configuration and starts the datapath. A
+    /// configuration the datapath cannot run (the driver validates before it writes; the RTL
+    /// would run it into undefined results) leaves the device idle.
+    fn arm(&mut self) {
+        let r = &mut self.registers;
+        let config = Config {
+            width: r.width_value(),
+            height: r.height_value(),
+            octaves: r.octaves_count(),
+            contrast_threshold: r.contrast_threshold_value(),
+            edge_ratio: r.edge_threshold_r(),
+            sobel_scale: r.output_mode_sobel_scale(),
+            max_offset: r.max_offset_value(),
+        };
+        if self.datapath.start_frame(&config).is_err() {
+            return;
+        }
+        self.phase = Phase::AwaitSof;
+        self.line_len = 0;
+        self.frame = Frame {
+            width: config.width,
+            total: u32::from(config.width) * u32::from(config.height),
+            taken: 0,
+            clock: 0,
+            latency: Some(latency::first_pixel_of_last_octave(
+                config.width,
+                config.height,
+                config.octaves,
+            )),
+            blank: 0,
+        };
+    }
+
+    /// SOFT_RESET.
+    fn soft_reset(&mut self) {
+        self.datapath.reset();
+        self.phase = Phase::Idle;
+        self.line_len = 0;
+        self.flags = 0;
+        self.drops_seen = Overflow::default();
+        self.frame_count = 0;
+        self.latency = 0;
+        self.point_hold = [0; 2];
+        self.sobel_hold = 0;
+    }
+
+    /// Accounts for `clocks` clocks of the running frame: the latency, the drop flags and the
+    /// end of the frame.
+    fn advance(&mut self, clocks: u32) {
+        self.frame.clock = self.frame.clock.saturating_add(clocks.into());
+        if let Some(at) = self.frame.latency {
+            if self.frame.clock > at {
+                self.latency = u32::try_from(at).unwrap_or(u32::MAX);
+                self.frame.latency = None;
+            }
+        }
+        let drops = self.datapath.overflow();
+        if drops.points != self.drops_seen.points {
+            self.flags |= status::POINT_OVERFLOW.mask();
+        }
+        if drops.sobel != self.drops_seen.sobel {
+            self.flags |= status::SOBEL_OVERFLOW.mask();
+        }
+        self.drops_seen = drops;
+        if self.phase == Phase::Flush && self.datapath.frame_done() {
+            self.phase = Phase::Idle;
+            self.flags |= status::FRAME_DONE.mask();
+            self.frame_count = self.frame_count.wrapping_add(1);
+        }
+    }
+
+    /// Feeds the frame's next pixels to the datapath a line at a time.
+    fn feed(&mut self, mut pixels: &[u8]) {
+        let width = usize::from(self.frame.width);
+        while !pixels.is_empty() && width > 0 {
+            let row = if self.line_len == 0 && pixels.len() >= width {
+                let Some((row, rest)) = pixels.split_at_checked(width) else {
+                    return;
+                };
+                pixels = rest;
+                row
+            } else {
+                let n = (width - self.line_len).min(pixels.len());
+                let (Some((part, rest)), Some(slot)) = (
+                    pixels.split_at_checked(n),
+                    self.line.get_mut(self.line_len..self.line_len + n),
+                ) else {
+                    // A line longer than the device gathers: the datapath refused such a
+                    // frame when it was armed, so this is not reached.
+                    return;
+                };
+                slot.copy_from_slice(part);
+                pixels = rest;
+                self.line_len += n;
+                if self.line_len < width {
+                    return;
+                }
+                self.line_len = 0;
+                match self.line.get(..width) {
+                    Some(row) => row,
+                    None => return,
+                }
+            };
+            // The row is `width` long and the frame has room for it (`push` counts), so the
+            // datapath takes it.
+            let _ = self.datapath.push_row(row);
+            self.advance(u32::from(self.frame.width));
+        }
+    }
+
+    /// Pops the point FIFO into POINT_FIFO_DATA's word and the holding registers.
+    fn pop_point(&mut self) -> u32 {
+        let [data, dxdy, dsdog] = self
+            .datapath
+            .pop_point()
+            .map_or([0; 3], |p| point_words(&p));
+        self.point_hold = [dxdy, dsdog];
+        data
+    }
+
+    /// Pops the Sobel FIFO into SOBEL_FIFO_DATA's word and the holding register.
+    fn pop_sobel(&mut self) -> u32 {
+        let [data, position] = self
+            .datapath
+            .pop_sobel()
+            .map_or([0; 2], |p| sobel_words(&p));
+        self.sobel_hold = position;
+        data
+    }
+}
+
+/// The word `offset` addresses, as the RTL decodes it; `None` outside the window.
+fn word(offset: u16) -> Option<u16> {
+    (u32::from(offset) < WINDOW_SIZE).then_some(offset & !3)
+}
+
+/// A FIFO level as its 16-bit field holds it.
+fn level(entries: usize) -> u32 {
+    u32::try_from(entries).map_or(u32::from(u16::MAX), |n| n.min(u16::MAX.into()))
+}
+
+impl<F: FrontEnd, const W0: usize> RegisterBus for FabricDevice<F, W0> {
+    fn read(&mut self, offset: u16) -> u32 {
+        let Some(offset) = word(offset) else {
+            return 0;
+        };
+        match offset {
+            version::OFFSET => version::RESET,
+            status::OFFSET => {
+                let busy = u32::from(self.phase != Phase::Idle);
+                self.flags | (busy << status::BUSY.bits.lsb)
+            }
+            point_fifo_level::OFFSET => level(self.datapath.point_level()),
+            sobel_fifo_level::OFFSET => level(self.datapath.sobel_level()),
+            point_overflow_count::OFFSET => self.datapath.overflow().points,
+            sobel_overflow_count::OFFSET => self.datapath.overflow().sobel,
+            frame_count::OFFSET => self.frame_count,
+            latency_clocks::OFFSET => self.latency,
+            point_fifo_data::OFFSET => self.pop_point(),
+            point_fifo_dxdy::OFFSET => self.point_hold[0],
+            point_fifo_dsdog::OFFSET => self.point_hold[1],
+            sobel_fifo_data::OFFSET => self.pop_sobel(),
+            sobel_fifo_position::OFFSET => self.sobel_hold,
+            // CONTROL and the configuration: stored; other words read 0.
+            _ => self.registers.try_read(offset).unwrap_or(0),
+        }
+    }
+
+    /// Bursts over SOBEL_FIFO_DATA and SOBEL_FIFO_POSITION take the datapath's Sobel FIFO by
+    /// runs; any other burst is read word by word. Either way the words are those of
+    /// [`RegisterBus::read`] one at a time.
+    fn read_burst(&mut self, offsets: &[u16], words: &mut [u32]) {
+        if offsets != SOBEL_OFFSETS {
+            for (word, &offset) in words.iter_mut().zip(offsets.iter().cycle()) {
+                *word = self.read(offset);
+            }
+            return;
+        }
+        let pairs = words.len() / 2;
+        let Some((whole, rest)) = words.split_at_mut_checked(pairs * 2) else {
+            return;
+        };
+        let mut filled = 0;
+        self.datapath.drain_sobel(pairs, &mut |run| {
+            if let Some(free) = whole.get_mut(filled * 2..) {
+                filled += sobel_run_words(&run, free);
+            }
+        });
+        // Pops of an empty FIFO read 0 and zero the holding register.
+        let Some((popped, empty)) = whole.split_at_mut_checked(filled * 2) else {
+            return;
+        };
+        empty.fill(0);
+        self.sobel_hold = if empty.is_empty() {
+            popped.last().copied().unwrap_or(self.sobel_hold)
+        } else {
+            0
+        };
+        for word in rest {
+            *word = self.pop_sobel();
+        }
+    }
+
+    fn write(&mut self, offset: u16, value: u32) {
+        let Some(offset) = word(offset) else {
+            return;
+        };
+        match offset {
+            control::OFFSET => {
+                let _ = self.registers.try_write(offset, value);
+                if value & control::SOFT_RESET.mask() != 0 {
+                    self.soft_reset();
+                } else if value & control::FRAME_ARM.mask() != 0 && self.phase == Phase::Idle {
+                    self.arm();
+                }
+            }
+            status::OFFSET => self.flags &= !(value & status::REGISTER.w1c_mask),
+            // The configuration; the bank ignores writes to `ro` bits and unmapped words.
+            _ => {
+                let _ = self.registers.try_write(offset, value);
+            }
+        }
+    }
+}
+
+impl<F: FrontEnd, const W0: usize> PixelIn for FabricDevice<F, W0> {
+    fn push(&mut self, pixels: &[u8], start_of_frame: bool) {
+        if !self.ready() {
+            return;
+        }
+        if self.phase == Phase::AwaitSof {
+            // Only the first pixel can carry SOF: without it, every pixel here is discarded.
+            if !start_of_frame || pixels.is_empty() {
+                return;
+            }
+            self.phase = Phase::Run;
+        }
+        let left = self.frame.total - self.frame.taken;
+        let take = pixels
+            .len()
+            .min(usize::try_from(left).unwrap_or(usize::MAX));
+        let Some(pixels) = pixels.get(..take) else {
+            return;
+        };
+        // `take <= left`, a u32.
+        self.frame.taken += take as u32;
+        if self.frame.taken == self.frame.total {
+            self.phase = Phase::Flush;
+        }
+        self.feed(pixels);
+    }
+
+    fn idle(&mut self, clocks: u32) {
+        match self.phase {
+            Phase::Run => self.advance(clocks),
+            Phase::Flush => {
+                let width = u32::from(self.frame.width);
+                self.frame.blank = self.frame.blank.saturating_add(clocks);
+                while self.phase == Phase::Flush && self.frame.blank >= width && width > 0 {
+                    self.frame.blank -= width;
+                    self.datapath.blank_row();
+                    self.advance(width);
+                }
+            }
+            Phase::Idle | Phase::AwaitSof => {}
+        }
+    }
+}
