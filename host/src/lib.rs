@@ -3,6 +3,7 @@
 pub mod calib;
 pub mod descriptor;
 pub mod driver;
+pub mod encoders;
 pub mod essential;
 pub mod estimator;
 pub mod eval;

@@ -145,6 +145,8 @@ struct InFlight {
     submitted: bool,
     timestamp_us: u64,
     truth_deg: Option<f64>,
+    /// The head's own verge reading for the pair (encoders or commanded), if it sent one.
+    encoder_verge_deg: Option<f64>,
 }
 
 /// One stereo head, from pixels to filtered verge angle, on device `D`.
@@ -168,6 +170,8 @@ pub struct Session<D: Device = Threaded> {
     early: Option<PairOutcome>,
     /// Capture time of the last pair filtered.
     last_timestamp_us: Option<u64>,
+    /// The head's verge reading for the next pair submitted ([`Session::encoder_reading`]).
+    next_encoder_deg: Option<f64>,
     cost: SessionCost,
 }
 
@@ -211,6 +215,7 @@ impl<D: Device> Session<D> {
             in_flight: VecDeque::new(),
             early: None,
             last_timestamp_us: None,
+            next_encoder_deg: None,
             cost: SessionCost::default(),
         })
     }
@@ -223,6 +228,13 @@ impl<D: Device> Session<D> {
     /// The device, e.g. to switch a fault injector or read an emulator's state.
     pub fn device_mut(&mut self) -> &mut D {
         self.driver.link_mut()
+    }
+
+    /// The head's own verge (deg, from its encoders or the angles it was commanded to) at the
+    /// capture of the next pair submitted: the filter predicts the change since the last
+    /// reading instead of detecting it (see [`crate::kalman`]).
+    pub fn encoder_reading(&mut self, verge_deg: f64) {
+        self.next_encoder_deg = Some(verge_deg);
     }
 
     /// Cost so far.
@@ -298,6 +310,7 @@ impl<D: Device> Session<D> {
             submitted: images.is_some(),
             timestamp_us,
             truth_deg,
+            encoder_verge_deg: self.next_encoder_deg.take(),
         })
     }
 
@@ -317,6 +330,7 @@ impl<D: Device> Session<D> {
             outcome,
             missing,
             pair.timestamp_us,
+            pair.encoder_verge_deg,
             pair.truth_deg,
         )?;
         self.cost.elapsed += start.elapsed();
@@ -332,7 +346,8 @@ impl<D: Device> Session<D> {
     /// link: the caller decides whether that ends the stream.
     ///
     /// A head may have been streaming before this host connected: the first pair's id, not
-    /// 0, is where the session's numbering starts.
+    /// 0, is where the session's numbering starts. A head that sends an `Encoders` reading
+    /// for the capture gives the filter its verge change as control input.
     pub fn receive(&mut self, frame: usize) -> Result<FrameRecord, SessionError> {
         let timeout = self.driver.link().answer_timeout();
         let mut expected = self.next_frame_id;
@@ -358,6 +373,10 @@ impl<D: Device> Session<D> {
             }
         };
         self.next_frame_id = expected.wrapping_add(1);
+        let encoder_verge_deg = self
+            .driver
+            .take_encoders(expected)
+            .map(|e| (i64::from(e.left_yaw_udeg) - i64::from(e.right_yaw_udeg)) as f64 * 1e-6);
         let start = Instant::now();
         let captured = match &outcome {
             Some(PairOutcome::Pair {
@@ -371,6 +390,7 @@ impl<D: Device> Session<D> {
             outcome,
             "the device skipped its frame id (its packets were lost on the link)",
             captured,
+            encoder_verge_deg,
             None,
         )?;
         self.cost.elapsed += start.elapsed();
@@ -385,6 +405,7 @@ impl<D: Device> Session<D> {
         outcome: Option<PairOutcome>,
         missing: &str,
         timestamp_us: u64,
+        encoder_verge_deg: Option<f64>,
         truth_deg: Option<f64>,
     ) -> Result<FrameRecord, SessionError> {
         let mut record = FrameRecord {
@@ -444,7 +465,7 @@ impl<D: Device> Session<D> {
         };
         let filtered = self
             .filter
-            .step(timestamp_us, measurement)
+            .step_with_encoders(timestamp_us, measurement, encoder_verge_deg)
             .map_err(|source| SessionError::Time { frame, source })?;
         self.last_timestamp_us = Some(timestamp_us);
         if record.status == FrameStatus::Ok {

@@ -292,6 +292,34 @@ fn truth_with_a_non_numeric_value() {
 }
 
 #[test]
+fn encoders_with_a_bad_field_or_a_frame_beyond_the_sequence() {
+    let f = Fixture::with_frames(2);
+    let encoders = f.path("encoders.csv");
+    let arg = display(&encoders);
+    for (text, expected) in [
+        (
+            "frame,left_yaw_deg,right_yaw_deg\n0,0.8,-0.8\n1,0.8,x\n",
+            vec![format!("{arg}:3"), "field `right_yaw_deg`: `x`".into()],
+        ),
+        (
+            "frame,verge_deg\n0,1.6\n2,1.6\n",
+            vec![
+                format!("{arg}:3"),
+                "frame 2 is beyond the sequence's 2 frames".into(),
+            ],
+        ),
+        (
+            "frame,yaw_deg\n0,1.6\n",
+            vec![arg.clone(), "header must be".into()],
+        ),
+    ] {
+        std::fs::write(&encoders, text).expect("write encoders");
+        let expected: Vec<&str> = expected.iter().map(String::as_str).collect();
+        f.assert_fails(&["--encoders", &arg], &expected);
+    }
+}
+
+#[test]
 fn textureless_sequence_gives_no_estimate_rows() {
     const FRAMES: usize = 3;
     let f = Fixture::new();

@@ -452,3 +452,52 @@ fn a_register_read_gets_its_error_report_while_unclaimed_reports_fill_the_list()
     assert_eq!(details, (1..64).collect::<Vec<u32>>());
     assert!(reports.iter().all(|r| r.report.code == ErrorCode::Busy));
 }
+
+#[test]
+fn encoder_readings_wait_for_their_capture_and_older_ones_go() {
+    use stereocal_wire::{EncodersRepr, PacketRepr};
+    let reading = |frame_id, left_yaw_udeg| {
+        PacketRepr::Encoders(EncodersRepr {
+            frame_id,
+            left_yaw_udeg,
+            right_yaw_udeg: -500_000,
+        })
+    };
+    let mut wire = Wire::new();
+    // A head stamps each capture's reading before its frames; the host may take them late.
+    for id in 1..=3u32 {
+        wire.push(&reading(id, 1_000_000 * id as i32));
+        wire.frame(&FrameSpec::small(id, Camera::Left));
+    }
+    let mut d = driver(&wire);
+    for _ in 0..3 {
+        delivered(d.next_frame(T).unwrap());
+    }
+    assert_eq!(d.take_encoders(2).map(|e| e.left_yaw_udeg), Some(2_000_000));
+    // Capture 1's reading went with 2's (no pair asks for an older capture again).
+    assert_eq!(d.take_encoders(1), None);
+    assert_eq!(d.take_encoders(4), None);
+    // Nor does a reading outlive a later capture's request.
+    assert_eq!(d.take_encoders(3), None);
+    assert_eq!(d.stats().stray_packets, 0);
+}
+
+#[test]
+fn unclaimed_encoder_readings_are_kept_bounded_to_the_newest() {
+    use stereocal_wire::{EncodersRepr, PacketRepr};
+    let mut wire = Wire::new();
+    for id in 0..100u32 {
+        wire.push(&PacketRepr::Encoders(EncodersRepr {
+            frame_id: id,
+            left_yaw_udeg: id as i32,
+            right_yaw_udeg: 0,
+        }));
+    }
+    wire.frame(&FrameSpec::small(100, Camera::Left));
+    let mut d = driver(&wire);
+    delivered(d.next_frame(T).unwrap());
+    // The newest 64 of the 100: 36 and later.
+    assert_eq!(d.take_encoders(35), None);
+    assert_eq!(d.take_encoders(36).map(|e| e.left_yaw_udeg), Some(36));
+    assert_eq!(d.take_encoders(99).map(|e| e.left_yaw_udeg), Some(99));
+}

@@ -49,6 +49,40 @@ fn moving_verge_is_tracked() {
 }
 
 #[test]
+fn a_motor_move_is_followed_from_its_first_frame() {
+    // Seed 10's first move starts between frames 12 and 13 and turns the verge by 3.4° in that
+    // interval, 8.8° in all: a filter that held its old value for a frame would be off by
+    // 3.4°.
+    let frames = 40;
+    let config = SequenceConfig {
+        frames,
+        seed: 10,
+        trajectory: TrajectoryKind::Motor,
+        ..SequenceConfig::for_scene(SceneKind::Road)
+    };
+    let sequence = Sequence::builtin(SceneKind::Road, config).expect("sequence");
+    let truth: Vec<f64> = (0..frames)
+        .map(|i| sequence.truth(i).expect("truth").verge_deg)
+        .collect();
+    let largest_step = truth
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
+    assert!(largest_step > 3.0, "largest step {largest_step}°");
+    let (records, _) =
+        evaluate(&sequence, SessionConfig::default(), &mut |_| {}).expect("evaluation");
+    let worst = records
+        .iter()
+        .filter_map(|r| Some((r.filtered_verge_deg? - truth[r.frame]).abs()))
+        .fold(0.0, f64::max);
+    assert!(
+        records.iter().all(|r| r.filtered_verge_deg.is_some()),
+        "every frame estimated"
+    );
+    assert!(worst <= 0.1, "filtered max error {worst}°");
+}
+
+#[test]
 fn sparse_scene_gives_no_estimate_on_every_frame() {
     for seed in 1..=3 {
         let config = SequenceConfig {

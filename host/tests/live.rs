@@ -85,6 +85,42 @@ struct Quirks {
     before: usize,
     /// A pair whose bytes it damages (one byte in the middle flipped) on the way out.
     damage: Option<usize>,
+    /// Whether it sends an `Encoders` reading before each pair ([`encoder_yaws_udeg`]).
+    encoders: bool,
+}
+
+/// The yaws (µdeg) a head with encoders reports for pair `i`: a left camera turning 0.3° per
+/// frame that the images do not show, so the filter's output tells whether it took them.
+fn encoder_yaws_udeg(i: usize) -> (i32, i32) {
+    (800_000 + 300_000 * i as i32, -800_000)
+}
+
+/// Re-numbers the link frames in `bytes` from `seq` on, with an `Encoders` packet for frame id
+/// `encoders_for` first when given: the device model numbers only its own packets, and a head
+/// whose firmware reads encoders numbers them all in one sequence.
+fn resequence(bytes: &[u8], seq: &mut u16, encoders_for: Option<usize>) -> Vec<u8> {
+    use stereocal_wire::{decode, encode, EncodersRepr, PacketRepr, MAX_FRAME_LEN};
+    let mut out = Vec::new();
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    let mut put = |repr: &PacketRepr<'_>, out: &mut Vec<u8>| {
+        out.extend_from_slice(encode(*seq, repr, &mut buf).unwrap());
+        *seq = seq.wrapping_add(1);
+    };
+    if let Some(i) = encoders_for {
+        let (left_yaw_udeg, right_yaw_udeg) = encoder_yaws_udeg(i);
+        let reading = EncodersRepr {
+            frame_id: i as u32,
+            left_yaw_udeg,
+            right_yaw_udeg,
+        };
+        put(&PacketRepr::Encoders(reading), &mut out);
+    }
+    for frame in bytes.split_inclusive(|&b| b == 0) {
+        let mut frame = frame.to_vec();
+        let (_, repr) = decode(&mut frame).unwrap();
+        put(&repr, &mut out);
+    }
+    out
 }
 
 fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool, q: Quirks) {
@@ -101,6 +137,7 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
     let mut buf = [0u8; 4096];
     let mut out = Vec::new();
     let mut grabbed = false;
+    let mut seq = 0u16;
     loop {
         match stream.read(&mut buf) {
             Ok(0) => return,
@@ -108,16 +145,19 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
             Err(_) => return,
         }
-        let mut send = |device: &mut InProcessLink, damage: bool| {
+        let mut send = |device: &mut InProcessLink, damage: bool, pair: Option<usize>| {
             out.clear();
             Device::take_sent(device, &mut out).unwrap();
+            if q.encoders {
+                out = resequence(&out, &mut seq, pair);
+            }
             if damage {
                 let middle = out.len() / 2;
                 out[middle] ^= 0x5a;
             }
             stream.write_all(&out).is_ok()
         };
-        if !send(&mut device, false) {
+        if !send(&mut device, false, None) {
             return;
         }
         if device.enabled() && !grabbed {
@@ -126,7 +166,7 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
                 device
                     .submit_pair(l, r, (i as f64 * PERIOD_US).round() as u64)
                     .unwrap();
-                if !send(&mut device, q.damage == Some(i)) {
+                if !send(&mut device, q.damage == Some(i), Some(i)) {
                     return;
                 }
             }
@@ -135,6 +175,15 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
             }
         }
     }
+}
+
+fn filtered_verges(csv: &Path) -> Vec<String> {
+    std::fs::read_to_string(csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).unwrap().to_owned())
+        .collect()
 }
 
 fn raw_verges(csv: &Path) -> Vec<String> {
@@ -408,6 +457,62 @@ fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
         .map(|l| l.rsplit(',').next().unwrap())
         .collect();
     assert_eq!(status, ["ok", "dropped", "ok"], "{csv}");
+}
+
+#[test]
+fn a_head_with_encoders_moves_the_filter_as_run_does_with_them() {
+    let quirks = Quirks {
+        encoders: true,
+        ..Quirks::default()
+    };
+    let (live, setup) = live_on_a_tcp_head(FRAMES, true, quirks, &[]);
+    assert!(
+        live.status.success(),
+        "{}",
+        String::from_utf8_lossy(&live.stderr)
+    );
+    let (seq, dir) = (&setup.seq, setup.dir.path());
+    let encoders = dir.join("encoders.csv");
+    let mut text = String::from("frame,left_yaw_deg,right_yaw_deg\n");
+    for i in 0..FRAMES {
+        let (l, r) = encoder_yaws_udeg(i);
+        text += &format!(
+            "{i},{:.6},{:.6}\n",
+            f64::from(l) * 1e-6,
+            f64::from(r) * 1e-6
+        );
+    }
+    std::fs::write(&encoders, text).unwrap();
+    let (left, right, calib) = (seq.join("left"), seq.join("right"), seq.join("calib.toml"));
+    let run = |extra: &[&str], out: &Path| {
+        let mut args = vec![
+            "run",
+            "--left",
+            left.to_str().unwrap(),
+            "--right",
+            right.to_str().unwrap(),
+            "--calib",
+            calib.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let done = stereocal(&args);
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+        filtered_verges(&out.join("verge.csv"))
+    };
+    let with = run(
+        &["--encoders", encoders.to_str().unwrap()],
+        &dir.join("with"),
+    );
+    let without = run(&[], &dir.join("without"));
+    let live = filtered_verges(&setup.out_dir().join("verge.csv"));
+    assert_eq!(live, with, "live takes the packets as run takes the CSV");
+    assert_ne!(with, without, "the readings moved the filter");
 }
 
 #[test]

@@ -39,6 +39,10 @@ pub(crate) fn read_u32(bytes: &[u8], field: Field) -> u32 {
     array(bytes, field).map_or(0, u32::from_le_bytes)
 }
 
+pub(crate) fn read_i32(bytes: &[u8], field: Field) -> i32 {
+    array(bytes, field).map_or(0, i32::from_le_bytes)
+}
+
 pub(crate) fn read_u64(bytes: &[u8], field: Field) -> u64 {
     array(bytes, field).map_or(0, u64::from_le_bytes)
 }
@@ -52,6 +56,10 @@ pub(crate) fn write_i16(bytes: &mut [u8], field: Field, value: i16) {
 }
 
 pub(crate) fn write_u32(bytes: &mut [u8], field: Field, value: u32) {
+    put(bytes, field, value.to_le_bytes());
+}
+
+pub(crate) fn write_i32(bytes: &mut [u8], field: Field, value: i32) {
     put(bytes, field, value.to_le_bytes());
 }
 

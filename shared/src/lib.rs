@@ -74,6 +74,7 @@ pub use checksum::crc32c;
 pub use error::Error;
 pub use frame::{decode, encode, max_frame_len, DELIMITER};
 pub use packet::camera::Camera;
+pub use packet::encoders::EncodersRepr;
 pub use packet::error_report::{ErrorCode, ErrorReportRepr};
 pub use packet::frame_end::{FrameEndFlags, FrameEndRepr};
 pub use packet::frame_start::FrameStartRepr;
@@ -114,6 +115,8 @@ pub const MAX_SOBEL_ROWS_LEN: usize = packet::sobel_rows::MAX_LEN;
 pub const MAX_SOBEL_PATCH_LEN: usize = packet::sobel_patch::LEN;
 /// Payload length of `FrameEnd`.
 pub const MAX_FRAME_END_LEN: usize = packet::frame_end::LEN;
+/// Payload length of `Encoders`.
+pub const MAX_ENCODERS_LEN: usize = packet::encoders::LEN;
 /// Largest payload of `Log`.
 pub const MAX_LOG_LEN: usize = packet::log::MAX_LEN;
 /// Payload length of `ErrorReport`.
@@ -131,6 +134,7 @@ pub const MAX_PAYLOAD_LEN: usize = {
         MAX_SOBEL_ROWS_LEN,
         MAX_SOBEL_PATCH_LEN,
         MAX_FRAME_END_LEN,
+        MAX_ENCODERS_LEN,
         MAX_LOG_LEN,
         MAX_ERROR_REPORT_LEN,
     ];

@@ -1,5 +1,6 @@
 //! Any packet, as one enum: what `encode` takes and `decode` gives back.
 
+use crate::packet::encoders::{self, EncodersRepr};
 use crate::packet::error_report::{self, ErrorReportRepr};
 use crate::packet::frame_end::{self, FrameEndRepr};
 use crate::packet::frame_start::{self, FrameStartRepr};
@@ -37,6 +38,8 @@ pub enum PacketRepr<'a> {
     SobelPatch(SobelPatchRepr<'a>),
     /// `0x14`
     FrameEnd(FrameEndRepr),
+    /// `0x15`
+    Encoders(EncodersRepr),
     /// `0x20`
     Log(LogRepr<'a>),
     /// `0x21` (the spec's `Error` kind)
@@ -56,6 +59,7 @@ impl<'a> PacketRepr<'a> {
             PacketRepr::SobelRows(_) => PacketKind::SobelRows,
             PacketRepr::SobelPatch(_) => PacketKind::SobelPatch,
             PacketRepr::FrameEnd(_) => PacketKind::FrameEnd,
+            PacketRepr::Encoders(_) => PacketKind::Encoders,
             PacketRepr::Log(_) => PacketKind::Log,
             PacketRepr::ErrorReport(_) => PacketKind::ErrorReport,
         }
@@ -73,6 +77,7 @@ impl<'a> PacketRepr<'a> {
             PacketRepr::SobelRows(repr) => repr.buffer_len(),
             PacketRepr::SobelPatch(repr) => repr.buffer_len(),
             PacketRepr::FrameEnd(repr) => repr.buffer_len(),
+            PacketRepr::Encoders(repr) => repr.buffer_len(),
             PacketRepr::Log(repr) => repr.buffer_len(),
             PacketRepr::ErrorReport(repr) => repr.buffer_len(),
         }
@@ -107,6 +112,9 @@ impl<'a> PacketRepr<'a> {
             )?),
             PacketKind::FrameEnd => PacketRepr::FrameEnd(FrameEndRepr::parse(
                 &frame_end::Packet::new_unchecked(payload),
+            )?),
+            PacketKind::Encoders => PacketRepr::Encoders(EncodersRepr::parse(
+                &encoders::Packet::new_unchecked(payload),
             )?),
             PacketKind::Log => {
                 PacketRepr::Log(LogRepr::parse(&log::Packet::new_unchecked(payload))?)
@@ -144,6 +152,7 @@ impl<'a> PacketRepr<'a> {
                 repr.emit(&mut sobel_patch::Packet::new_unchecked(payload))
             }
             PacketRepr::FrameEnd(repr) => repr.emit(&mut frame_end::Packet::new_unchecked(payload)),
+            PacketRepr::Encoders(repr) => repr.emit(&mut encoders::Packet::new_unchecked(payload)),
             PacketRepr::Log(repr) => repr.emit(&mut log::Packet::new_unchecked(payload)),
             PacketRepr::ErrorReport(repr) => {
                 repr.emit(&mut error_report::Packet::new_unchecked(payload))

@@ -17,8 +17,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use stereocal_wire::{
-    decode, encode, Camera, Capabilities, ErrorCode, ErrorReportRepr, FrameEndFlags, FrameEndRepr,
-    FrameStartRepr, HelloRepr, LogRepr, PacketRepr, Point, PointBatchRepr, Records,
+    decode, encode, Camera, Capabilities, EncodersRepr, ErrorCode, ErrorReportRepr, FrameEndFlags,
+    FrameEndRepr, FrameStartRepr, HelloRepr, LogRepr, PacketRepr, Point, PointBatchRepr, Records,
     RegisterReadRepr, RegisterValueRepr, RegisterWriteRepr, SobelPatchRepr, SobelPixel,
     SobelRowsRepr, MAX_FRAME_LEN, PATCH_PIXELS,
 };
@@ -185,6 +185,17 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
                     flags: FrameEndFlags::POINT_FIFO_OVERFLOW | FrameEndFlags::SOBEL_FIFO_OVERFLOW,
                     dropped_points: 3,
                     dropped_sobel: 1280,
+                }),
+            ),
+        ),
+        (
+            "encoders",
+            (
+                0x0107,
+                PacketRepr::Encoders(EncodersRepr {
+                    frame_id: 42,
+                    left_yaw_udeg: 7_500_000,
+                    right_yaw_udeg: -1_250_000,
                 }),
             ),
         ),

@@ -6,6 +6,7 @@ use std::sync::mpsc;
 use anyhow::Context;
 use clap::Args;
 use stereocal::calib::Calibration;
+use stereocal::encoders::read_encoders_csv;
 use stereocal::record::FrameRecord;
 use stereocal::sequence::{GrayFrame, SizeLimits, StereoSequence};
 use stereocal::session::{fabric_config, Session};
@@ -37,6 +38,11 @@ pub struct RunArgs {
     /// rig's own constant residual verge is removed first.
     #[arg(long)]
     truth: Option<PathBuf>,
+    /// The head's own verge per frame, from its joint encoders or commanded angles:
+    /// `frame,left_yaw_deg,right_yaw_deg` or `frame,verge_deg` (frames without a row have no
+    /// reading). The filter predicts each frame's verge change from it instead of detecting it.
+    #[arg(long)]
+    encoders: Option<PathBuf>,
     /// Where verge.csv and verge.png go.
     #[arg(long, default_value = "out/run")]
     out: PathBuf,
@@ -70,6 +76,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             );
             Some(truth)
         }
+        None => None,
+    };
+    let encoders = match &args.encoders {
+        Some(path) => Some(read_encoders_csv(path, sequence.len())?),
         None => None,
     };
     let first = sequence.pair(0, None)?;
@@ -122,6 +132,9 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         let mut records = Vec::with_capacity(sequence.len());
         for (frame, pair) in rx.into_iter().enumerate() {
             let (l, r) = pair?;
+            if let Some(verge) = encoders.as_ref().and_then(|e| e[frame]) {
+                session.encoder_reading(verge);
+            }
             let record = session.submit(
                 frame,
                 Some((&l.pixels, &r.pixels)),

@@ -78,7 +78,7 @@ pub struct SynthArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Directory to create (must not exist or be empty): left/, right/, calib.toml,
-    /// truth.csv, frames.csv.
+    /// truth.csv, frames.csv, encoders.csv.
     #[arg(long)]
     out: PathBuf,
 }

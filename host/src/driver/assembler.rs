@@ -12,8 +12,8 @@ use std::collections::VecDeque;
 
 use stereocal_hdl::regs;
 use stereocal_wire::{
-    Camera, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr, Header, HelloRepr,
-    PacketKind, PacketRepr, Point, RegisterValueRepr,
+    Camera, EncodersRepr, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr, Header,
+    HelloRepr, PacketKind, PacketRepr, Point, RegisterValueRepr,
 };
 
 use super::damage::{ContentError, Damage, PacketRef};
@@ -122,6 +122,7 @@ pub(crate) enum Event {
     RegisterValue(RegisterValueRepr),
     Log(LogFrame),
     DeviceError { seq: u16, report: ErrorReportRepr },
+    Encoders(EncodersRepr),
 }
 
 /// The frame being assembled.
@@ -344,6 +345,7 @@ impl FrameAssembler {
                 }));
             }
             PacketRepr::RegisterValue(v) => self.events.push_back(Event::RegisterValue(*v)),
+            PacketRepr::Encoders(e) => self.events.push_back(Event::Encoders(*e)),
             PacketRepr::ErrorReport(report) => {
                 self.stats.device_errors += 1;
                 self.events.push_back(Event::DeviceError {

@@ -35,7 +35,7 @@ use std::time::{Duration, Instant};
 
 use stereocal_hdl::{FabricConfig, Registers};
 use stereocal_wire::{
-    encode, Accumulator, Camera, ErrorReportRepr, FeedResult, HelloRepr, PacketRepr,
+    encode, Accumulator, Camera, EncodersRepr, ErrorReportRepr, FeedResult, HelloRepr, PacketRepr,
     RegisterReadRepr, RegisterWriteRepr, MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 
@@ -104,6 +104,11 @@ impl PairOutcome {
 /// Unclaimed device `ErrorReport`s kept (the newest).
 const MAX_DEVICE_ERRORS: usize = 64;
 
+/// Unclaimed `Encoders` readings kept (the newest): two seconds of captures at 30 fps, far
+/// more than the pairs a session has in flight, so a reading waits for its pair however the
+/// link interleaves them, and a head whose readings nobody takes cannot grow the host.
+const MAX_ENCODER_READINGS: usize = 64;
+
 /// An `ErrorReport` the device sent outside a request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DeviceReport {
@@ -131,6 +136,7 @@ pub struct Driver<L: Link> {
     register_values: VecDeque<(u16, u32)>,
     device_errors: VecDeque<DeviceReport>,
     logs: VecDeque<LogFrame>,
+    encoders: VecDeque<EncodersRepr>,
 }
 
 impl<L: Link> Driver<L> {
@@ -151,6 +157,7 @@ impl<L: Link> Driver<L> {
             hellos: VecDeque::new(),
             register_values: VecDeque::new(),
             device_errors: VecDeque::new(),
+            encoders: VecDeque::new(),
             logs: VecDeque::new(),
         }
     }
@@ -183,6 +190,20 @@ impl<L: Link> Driver<L> {
     /// `ErrorReport`s the device sent outside a request, emptying the list.
     pub fn take_device_errors(&mut self) -> Vec<DeviceReport> {
         self.device_errors.drain(..).collect()
+    }
+
+    /// The head's `Encoders` reading of capture `frame_id`, if it arrived; readings of this
+    /// and older captures (ids wrap: within half the id space behind) are dropped, as no pair
+    /// will ask for them again.
+    pub fn take_encoders(&mut self, frame_id: u32) -> Option<EncodersRepr> {
+        let mut found = None;
+        self.encoders.retain(|e| {
+            if e.frame_id == frame_id {
+                found = Some(*e);
+            }
+            frame_id.wrapping_sub(e.frame_id) > u32::MAX / 2
+        });
+        found
     }
 
     /// Sends the host's `Hello` and waits for the device's (one already received counts).
@@ -428,6 +449,12 @@ impl<L: Link> Driver<L> {
                         self.device_errors.pop_front();
                     }
                     self.device_errors.push_back(DeviceReport { seq, report })
+                }
+                Event::Encoders(e) => {
+                    if self.encoders.len() >= MAX_ENCODER_READINGS {
+                        self.encoders.pop_front();
+                    }
+                    self.encoders.push_back(e);
                 }
             }
         }

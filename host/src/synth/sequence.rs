@@ -473,6 +473,17 @@ impl Sequence {
         s
     }
 
+    /// `frame,left_yaw_deg,right_yaw_deg` for every frame: what the head's joint encoders read,
+    /// exactly (the thesis' head had encoders on every axis), for `run --encoders`.
+    pub fn encoders_csv(&self) -> String {
+        let mut s = String::from("frame,left_yaw_deg,right_yaw_deg\n");
+        for i in 0..self.len() {
+            let t = Truth::from(&self.trajectory.state(self.time_s(i)));
+            let _ = writeln!(s, "{i},{:.9},{:.9}", t.alpha_l_deg, t.alpha_r_deg);
+        }
+        s
+    }
+
     /// Per-frame details: time, both yaws, tilt, dropped, field parity.
     pub fn frames_csv(&self) -> String {
         let mut s = String::from(
@@ -496,7 +507,8 @@ impl Sequence {
     }
 
     /// Write `left/NNNNNN.png`, `right/NNNNNN.png` (8-bit grey; no files for dropped frames,
-    /// so the numbering shows the gap), `calib.toml`, `truth.csv` and `frames.csv` into `dir`.
+    /// so the numbering shows the gap), `calib.toml`, `truth.csv`, `frames.csv` and
+    /// `encoders.csv` into `dir`.
     /// `dir` must not exist or be empty; everything is written to a sibling staging directory
     /// that is renamed into place at the end, so a failure or Ctrl-C leaves nothing
     /// half-written.
@@ -558,6 +570,7 @@ impl Sequence {
             ("calib.toml", self.calib_toml()),
             ("truth.csv", self.truth_csv()),
             ("frames.csv", self.frames_csv()),
+            ("encoders.csv", self.encoders_csv()),
         ] {
             let path = dir.join(name);
             fs::write(&path, text).map_err(io(&path))?;

@@ -4,7 +4,11 @@
 //! camera moved independently by hand over a ±15° verge range, smooth moves with pauses),
 //! [`TrajectoryKind::Fixed`] is figure 5.2 (cameras fixed at a verge of about 1.6° while the car
 //! drives), and [`TrajectoryKind::Steps`] holds a list of verge values for two seconds each,
-//! switching instantaneously, which shows a filter's step response.
+//! switching instantaneously, which shows a filter's step response. [`TrajectoryKind::Motor`]
+//! is figure 5.1 as a motorised head would make it: the same pauses and one-camera moves, but
+//! each move at a constant speed from its first instant, as a servo reaches its speed within
+//! milliseconds, far less than a frame interval, so a move starts between two frames with
+//! several degrees to go.
 
 use std::f64::consts::PI;
 use std::fmt;
@@ -26,16 +30,19 @@ pub enum TrajectoryKind {
     Fixed,
     /// A fixed list of verge values, two seconds each, instantaneous switches.
     Steps,
+    /// Fig. 5.1's moves made by motors: constant speed from the first instant of a move.
+    Motor,
 }
 
 impl TrajectoryKind {
-    pub const ALL: [TrajectoryKind; 3] = [Self::Manual, Self::Fixed, Self::Steps];
+    pub const ALL: [TrajectoryKind; 4] = [Self::Manual, Self::Fixed, Self::Steps, Self::Motor];
 
     pub fn name(self) -> &'static str {
         match self {
             Self::Manual => "manual",
             Self::Fixed => "fixed",
             Self::Steps => "steps",
+            Self::Motor => "motor",
         }
     }
 }
@@ -108,13 +115,23 @@ struct Key {
     alpha_r_deg: f64,
 }
 
+/// How the yaws go from one key to the next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Between {
+    /// A cosine ease: a hand starts and stops a move gently (`Manual`).
+    Ease,
+    /// Linear, at constant speed: a motor's move (`Motor`).
+    Linear,
+    /// Held until the next key (`Steps`, `Fixed`).
+    Hold,
+}
+
 /// Where the head and the vehicle go over time. Deterministic for a seed.
 #[derive(Debug, Clone)]
 pub struct Trajectory {
     kind: TrajectoryKind,
     keys: Vec<Key>,
-    /// Ease between keys (`Manual`) or hold until the next key (`Steps`, `Fixed`).
-    eased: bool,
+    between: Between,
     start: Vector3<f64>,
     speed_mps: f64,
     tilt_deg: f64,
@@ -142,22 +159,23 @@ impl Trajectory {
         speed_mps: f64,
         tilt_deg: f64,
     ) -> Self {
-        let (keys, eased) = match kind {
-            TrajectoryKind::Manual => (manual_keys(seed, duration_s), true),
+        let (keys, between) = match kind {
+            TrajectoryKind::Manual => (manual_keys(seed, duration_s, hand_speed), Between::Ease),
+            TrajectoryKind::Motor => (manual_keys(seed, duration_s, motor_speed), Between::Linear),
             TrajectoryKind::Fixed => (
                 vec![Key {
                     t_s: 0.0,
                     alpha_l_deg: FIXED_VERGE_DEG / 2.0,
                     alpha_r_deg: -FIXED_VERGE_DEG / 2.0,
                 }],
-                false,
+                Between::Hold,
             ),
-            TrajectoryKind::Steps => (step_keys(duration_s), false),
+            TrajectoryKind::Steps => (step_keys(duration_s), Between::Hold),
         };
         Trajectory {
             kind,
             keys,
-            eased,
+            between,
             start,
             speed_mps,
             tilt_deg,
@@ -198,10 +216,14 @@ impl Trajectory {
             let first = self.keys[0];
             return (first.alpha_l_deg, first.alpha_r_deg);
         };
-        match self.keys.get(next) {
-            Some(to) if self.eased => {
+        match (self.keys.get(next), self.between) {
+            (Some(to), Between::Ease | Between::Linear) => {
                 let s = (t_s - prev.t_s) / (to.t_s - prev.t_s);
-                let w = 0.5 - 0.5 * (PI * s).cos();
+                let w = if self.between == Between::Ease {
+                    0.5 - 0.5 * (PI * s).cos()
+                } else {
+                    s
+                };
                 (
                     prev.alpha_l_deg + (to.alpha_l_deg - prev.alpha_l_deg) * w,
                     prev.alpha_r_deg + (to.alpha_r_deg - prev.alpha_r_deg) * w,
@@ -212,9 +234,21 @@ impl Trajectory {
     }
 }
 
+/// A hand's speed, 6-20 °/s (fig. 5.1's moves); a move lasts at least 0.3 s, as a hand does.
+fn hand_speed(rng: &mut ChaCha8Rng, degrees: f64) -> f64 {
+    (degrees / rng.random_range(6.0..20.0)).max(0.3)
+}
+
+/// A verge motor's speed, 30-150 °/s: from a slow pursuit to a fast but ordinary turn of a head
+/// like the thesis' CeDAR (chapter 4: "motions that exceed human performance"), so a move
+/// covers 1-5° per frame interval at 30 fps; it lasts as long as the distance takes.
+fn motor_speed(rng: &mut ChaCha8Rng, degrees: f64) -> f64 {
+    degrees / rng.random_range(30.0..150.0)
+}
+
 /// Fig. 5.1 style: alternate pauses and moves of one camera (chosen at random) to a new verge
-/// drawn uniformly in ±15°, at a hand-like speed of 6-20 °/s.
-fn manual_keys(seed: u64, duration_s: f64) -> Vec<Key> {
+/// drawn uniformly in ±15°; `duration` draws how long a move of so many degrees takes.
+fn manual_keys(seed: u64, duration_s: f64, duration: fn(&mut ChaCha8Rng, f64) -> f64) -> Vec<Key> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6d61_6e75_616c);
     let mut key = Key {
         t_s: 0.0,
@@ -239,7 +273,7 @@ fn manual_keys(seed: u64, duration_s: f64) -> Vec<Key> {
             key.alpha_r_deg = a;
             delta
         };
-        key.t_s += (moved / rng.random_range(6.0..20.0)).max(0.3);
+        key.t_s += duration(&mut rng, moved);
         keys.push(key);
     }
     keys
@@ -290,6 +324,30 @@ mod tests {
         assert!(
             hi - lo > 15.0,
             "manual moves should sweep most of the range"
+        );
+    }
+
+    #[test]
+    fn motor_moves_start_at_full_speed_within_range() {
+        let t = make(TrajectoryKind::Motor, 3);
+        let frame = 1.0 / 30.0;
+        let (mut onsets, mut fastest) = (0, 0f64);
+        let mut prev_step = 0.0;
+        for i in 1..1800 {
+            let at = |k: i32| t.state(f64::from(k) * frame).verge_deg();
+            let step = at(i) - at(i - 1);
+            assert!(at(i).abs() <= 15.0 + 1e-9, "verge {} out of range", at(i));
+            // An onset: still over one frame interval, a degree or more over the next.
+            if prev_step == 0.0 && step.abs() >= 1.0 {
+                onsets += 1;
+            }
+            fastest = fastest.max(step.abs());
+            prev_step = step;
+        }
+        assert!(onsets >= 10, "{onsets} abrupt onsets in 60 s");
+        assert!(
+            (4.0..=5.0).contains(&fastest),
+            "fastest {fastest}° per frame"
         );
     }
 

@@ -22,6 +22,8 @@ pub enum PacketKind {
     SobelPatch,
     /// `0x14`, device to host: a camera frame ends, with counters.
     FrameEnd,
+    /// `0x15`, device to host: the head's camera yaws at a stereo capture.
+    Encoders,
     /// `0x20`, device to host: one defmt log frame.
     Log,
     /// `0x21`, both ways: an error report.
@@ -42,6 +44,7 @@ impl From<u8> for PacketKind {
             0x12 => PacketKind::SobelRows,
             0x13 => PacketKind::SobelPatch,
             0x14 => PacketKind::FrameEnd,
+            0x15 => PacketKind::Encoders,
             0x20 => PacketKind::Log,
             0x21 => PacketKind::ErrorReport,
             other => PacketKind::Unknown(other),
@@ -61,6 +64,7 @@ impl From<PacketKind> for u8 {
             PacketKind::SobelRows => 0x12,
             PacketKind::SobelPatch => 0x13,
             PacketKind::FrameEnd => 0x14,
+            PacketKind::Encoders => 0x15,
             PacketKind::Log => 0x20,
             PacketKind::ErrorReport => 0x21,
             PacketKind::Unknown(other) => other,

@@ -65,6 +65,7 @@ fn check_room(actual: usize, needed: usize) -> Result<(), crate::Error> {
 }
 
 pub mod camera;
+pub mod encoders;
 pub mod error_report;
 pub mod frame_end;
 pub mod frame_start;

@@ -3,10 +3,10 @@
 use proptest::collection::vec;
 use proptest::prelude::*;
 use stereocal_wire::{
-    Camera, Capabilities, ErrorCode, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr,
-    HelloRepr, LogRepr, PacketRepr, Point, PointBatchRepr, Records, RegisterReadRepr,
-    RegisterValueRepr, RegisterWriteRepr, SobelPatchRepr, SobelPixel, SobelRowsRepr, MAX_LOG_LEN,
-    MAX_POINTS, MAX_SOBEL_ROW_WIDTH, PATCH_PIXELS,
+    Camera, Capabilities, EncodersRepr, ErrorCode, ErrorReportRepr, FrameEndFlags, FrameEndRepr,
+    FrameStartRepr, HelloRepr, LogRepr, PacketRepr, Point, PointBatchRepr, Records,
+    RegisterReadRepr, RegisterValueRepr, RegisterWriteRepr, SobelPatchRepr, SobelPixel,
+    SobelRowsRepr, MAX_LOG_LEN, MAX_POINTS, MAX_SOBEL_ROW_WIDTH, PATCH_PIXELS,
 };
 
 /// A packet that owns its records.
@@ -158,6 +158,13 @@ fn fixed() -> impl Strategy<Value = PacketRepr<'static>> {
                 })
             }
         ),
+        any::<(u32, i32, i32)>().prop_map(|(frame_id, left_yaw_udeg, right_yaw_udeg)| {
+            PacketRepr::Encoders(EncodersRepr {
+                frame_id,
+                left_yaw_udeg,
+                right_yaw_udeg,
+            })
+        }),
         (any::<u16>(), any::<u32>()).prop_map(|(code, detail)| PacketRepr::ErrorReport(
             ErrorReportRepr {
                 code: ErrorCode::from(code),
