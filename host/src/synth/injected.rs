@@ -350,6 +350,7 @@ mod tests {
             baseline_m: 0.3,
             left: cam,
             right: cam,
+            extrinsics: Extrinsics::default(),
         };
         let dir = tmp.path().join("set");
         let source = Source::Sequence(&seq);
