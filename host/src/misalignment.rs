@@ -7,7 +7,9 @@
 //! error moves from view to view. Frames with different views constrain the shared angles
 //! jointly, and the current frame's verge is then refitted with them held
 //! ([`misaligned::refine_yaws`]). Each Gauss-Newton step eliminates the per-frame yaws by the
-//! Schur complement, so a step costs one pass over the window's matches and a 3x3 solve.
+//! Schur complement, so a step costs one pass over the window's matches and a 3x3 solve. A
+//! frame that leaves the window leaves its information about the shared angles behind, as a
+//! Gaussian prior (marginalisation), so the window bounds the cost, not the memory.
 
 use std::collections::VecDeque;
 
@@ -28,6 +30,9 @@ pub struct WindowConfig {
     pub tilt: bool,
     /// Joint Gauss-Newton steps per new frame.
     pub steps: usize,
+    /// Frames the prior of the marginalised frames remembers: each frame that leaves the
+    /// window first discounts the prior by `1 - 1/memory`.
+    pub memory: usize,
 }
 
 impl Default for WindowConfig {
@@ -35,12 +40,16 @@ impl Default for WindowConfig {
     /// while 30 frames of about 500 matches keep a step near a millisecond on two cores, and
     /// a misalignment that drifts (temperature, a knock) is forgotten within 30 frames. Two
     /// steps per frame: every frame stays in the window for 30 frames, so its yaws and the
-    /// shared angles converge over 60 steps; two keep up with a drifting misalignment.
+    /// shared angles converge over 60 steps; two keep up with a drifting misalignment. A
+    /// memory of 300 frames (half a minute at 10 Hz) lets the shared angles' noise fall to
+    /// about 1/√300 of one frame's, while a misalignment that drifts with temperature, over
+    /// minutes, is still followed.
     fn default() -> Self {
         Self {
             frames: 30,
             tilt: false,
             steps: 2,
+            memory: 300,
         }
     }
 }
@@ -77,6 +86,21 @@ struct FrameNormal {
     bs: Vector3<f64>,
 }
 
+impl FrameNormal {
+    /// The frame's information and gradient on the shared block with its yaws eliminated
+    /// (Schur complement), and the inverse of its yaw block; `None` when its yaws are not
+    /// determined.
+    fn reduced(&self) -> Option<(Matrix3<f64>, Vector3<f64>, Matrix2<f64>)> {
+        let aa_inv = self.aa.try_inverse()?;
+        let cross = self.as_.transpose() * aa_inv;
+        Some((
+            self.ss - cross * self.as_,
+            self.bs - cross * self.ba,
+            aa_inv,
+        ))
+    }
+}
+
 /// The sliding-window joint estimator of the head's fixed misalignments.
 #[derive(Debug, Clone)]
 pub struct MisalignmentWindow {
@@ -85,6 +109,10 @@ pub struct MisalignmentWindow {
     shared: Misalignment,
     covariance: Matrix3<f64>,
     frames: VecDeque<WindowFrame>,
+    /// What the frames that left the window said about the shared angles: information
+    /// matrix and the angles it centres on.
+    prior_information: Matrix3<f64>,
+    prior_mean: Vector3<f64>,
 }
 
 impl MisalignmentWindow {
@@ -96,6 +124,8 @@ impl MisalignmentWindow {
             shared: Misalignment::from_extrinsics(extrinsics),
             covariance: Matrix3::zeros(),
             frames: VecDeque::with_capacity(config.frames + 1),
+            prior_information: Matrix3::zeros(),
+            prior_mean: Vector3::zeros(),
         }
     }
 
@@ -127,7 +157,9 @@ impl MisalignmentWindow {
             angles: first.angles,
         });
         while self.frames.len() > self.config.frames {
-            self.frames.pop_front();
+            if let Some(old) = self.frames.pop_front() {
+                self.marginalise(&old);
+            }
         }
         for _ in 0..self.config.steps {
             self.step();
@@ -137,6 +169,25 @@ impl MisalignmentWindow {
             misaligned::refine_yaws(&newest.matches, newest.angles, &self.shared, &self.refine)?;
         newest.angles = fit.angles;
         Ok(fit)
+    }
+
+    /// Folds what `frame` says about the shared angles, its yaws eliminated, into the prior,
+    /// linearised at the current estimate, after discounting the prior by the memory.
+    fn marginalise(&mut self, frame: &WindowFrame) {
+        let Some((info, grad)) = frame_normal(frame, &self.shared, &self.refine)
+            .and_then(|n| n.reduced().map(|(s, g, _)| (s, g)))
+        else {
+            return;
+        };
+        let keep = 1.0 - 1.0 / self.config.memory.max(1) as f64;
+        let old = self.prior_information * keep;
+        let total = old + info;
+        let Some(total_inv) = total.try_inverse() else {
+            return;
+        };
+        let s = self.shared.to_vector();
+        self.prior_mean = total_inv * (old * self.prior_mean + info * s - grad);
+        self.prior_information = total;
     }
 
     /// One robust Gauss-Newton step of the joint fit. A shared block the window does not
@@ -150,21 +201,18 @@ impl MisalignmentWindow {
             .par_iter()
             .map(|f| frame_normal(f, &shared, &refine))
             .collect();
-        let mut s = Matrix3::zeros();
-        let mut g = Vector3::zeros();
+        let mut s = self.prior_information;
+        let mut g = self.prior_information * (self.shared.to_vector() - self.prior_mean);
         let mut reduced = Vec::with_capacity(normals.len());
         for n in &normals {
-            let Some(n) = n else {
-                reduced.push(None);
-                continue;
-            };
-            let Some(aa_inv) = n.aa.try_inverse() else {
-                reduced.push(None);
-                continue;
-            };
-            s += n.ss - n.as_.transpose() * aa_inv * n.as_;
-            g += n.bs - n.as_.transpose() * aa_inv * n.ba;
-            reduced.push(Some(aa_inv));
+            match n.as_ref().and_then(FrameNormal::reduced) {
+                Some((sj, gj, aa_inv)) => {
+                    s += sj;
+                    g += gj;
+                    reduced.push(Some(aa_inv));
+                }
+                None => reduced.push(None),
+            }
         }
         // Held angles: their rows and columns leave the system.
         let free = [true, true, self.config.tilt];
@@ -332,6 +380,51 @@ mod tests {
         assert!((est.pitch_deg + 0.1).abs() < 0.01, "{est:?}");
         assert!((est.roll_deg - 0.05).abs() < 0.01, "{est:?}");
         assert!((est.baseline_tilt_deg - 0.3).abs() < 0.05, "{est:?}");
+    }
+
+    /// Frames that leave a short window keep informing the shared angles through the prior:
+    /// with a memory the estimate is as accurate as the long window's and surer than a window
+    /// that forgets them at once.
+    #[test]
+    fn frames_that_leave_the_window_stay_in_its_prior() {
+        let truth = Misalignment {
+            pitch: 0.12f64.to_radians(),
+            roll: -0.08f64.to_radians(),
+            tilt: 0.0,
+        };
+        let refine = RefineConfig::default();
+        let run = |memory: usize| {
+            let config = WindowConfig {
+                frames: 5,
+                memory,
+                ..WindowConfig::default()
+            };
+            let mut window = MisalignmentWindow::new(&Extrinsics::default(), config, refine);
+            for k in 0..40u64 {
+                let a = VergeAngles::new(
+                    (1.0 + 0.3 * (k as f64 * 0.5).sin()).to_radians(),
+                    -0.4f64.to_radians(),
+                );
+                let m = misaligned_synthetic(a, &truth, 400, 0.2, 700.0, 300 + k);
+                let plain = constrained::refine(&m, a, &refine).unwrap();
+                window.update(m, plain.angles).unwrap();
+            }
+            window.estimate()
+        };
+        let (remembering, forgetting) = (run(300), run(1));
+        assert_eq!(remembering.frames, 5);
+        assert!(
+            (remembering.pitch_deg - 0.12).abs() < 0.01,
+            "{remembering:?}"
+        );
+        assert!(
+            (remembering.roll_deg + 0.08).abs() < 0.01,
+            "{remembering:?}"
+        );
+        assert!(
+            remembering.pitch_sigma_deg < 0.6 * forgetting.pitch_sigma_deg,
+            "{remembering:?} vs {forgetting:?}"
+        );
     }
 
     /// The window starts from the calibration's misalignments and, without tilt, holds its
