@@ -85,7 +85,9 @@ pub struct EstimateArgs {
     #[arg(long, value_enum, default_value_t = ModelArg::Constrained)]
     model: ModelArg,
     /// The head's fixed misalignments: each frame alone, or learned over a window
-    /// (constrained model only; the general model frees them in every frame).
+    /// (constrained model only; the general model frees them in every frame). Off by default:
+    /// on the KITTI drive the window lowers every trajectory's maximum error but raises the
+    /// moving and swing medians (README, "The head's fixed misalignments").
     #[arg(long, value_enum, default_value_t = MisalignmentArg::Off)]
     misalignment: MisalignmentArg,
     /// Sobel output mode of the fabric.
