@@ -23,6 +23,7 @@
 
 pub mod constrained;
 pub mod general;
+pub mod misaligned;
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -112,7 +113,7 @@ pub enum RobustLoss {
 
 impl RobustLoss {
     /// IRLS weight of a residual `r` given the noise scale `sigma`.
-    fn weight(self, r: f64, sigma: f64) -> f64 {
+    pub(crate) fn weight(self, r: f64, sigma: f64) -> f64 {
         match self {
             RobustLoss::LeastSquares => 1.0,
             RobustLoss::Huber => {
@@ -156,7 +157,7 @@ impl Default for RefineConfig {
 }
 
 /// Robust noise scale from the median absolute residual.
-fn mad_sigma(residuals: &[f64], floor: f64) -> f64 {
+pub(crate) fn mad_sigma(residuals: &[f64], floor: f64) -> f64 {
     let mut abs: Vec<f64> = residuals.iter().map(|r| r.abs()).collect();
     if abs.is_empty() {
         return floor;
@@ -238,5 +239,23 @@ pub(crate) mod testutil {
             });
         }
         out
+    }
+
+    /// [`synthetic`] matches of a head with yaws `a` and misalignments `m` (baseline 0.3 m).
+    /// The generator's baseline lies along x, so the tilt turns the whole head by `-tilt`
+    /// about z: in the head's own frame the baseline then points along `(cos tilt, sin tilt,
+    /// 0)`.
+    pub fn misaligned_synthetic(
+        a: super::constrained::VergeAngles,
+        m: &super::misaligned::Misalignment,
+        n: usize,
+        noise_px: f64,
+        f: f64,
+        seed: u64,
+    ) -> Vec<Correspondence> {
+        let turn = rot_z(-m.tilt);
+        let left = turn * rot_y(a.alpha_l);
+        let right = turn * rot_y(a.alpha_r) * rot_x(m.pitch) * rot_z(m.roll);
+        synthetic(left, right, 0.3, n, noise_px, f, seed)
     }
 }

@@ -137,6 +137,10 @@ pub struct FrameEstimate {
     /// The descriptor matches by the octave of their left keypoint; sums to `matches`, empty
     /// when estimated from pixel pairs. Fig. 5.3 asks how much the coarse octaves contribute.
     pub matches_per_octave: Vec<usize>,
+    /// Constrained model: the matches consistent with the estimate, calibrated and weighted as
+    /// the refinement took them; the misalignment window fits its shared angles to them.
+    /// General model: empty.
+    pub consistent: Vec<Correspondence>,
 }
 
 /// The per-frame verge estimator.
@@ -297,6 +301,11 @@ impl VergeEstimator {
             residual_px: cfit.residual_sigma * focal,
             keypoints_per_octave: Vec::new(),
             matches_per_octave: Vec::new(),
+            consistent: corr
+                .iter()
+                .zip(&cfit.inliers)
+                .filter_map(|(c, &inlier)| inlier.then_some(*c))
+                .collect(),
         };
         if self.config.model == Model::General {
             // Two starts: the constrained solution (right when the head only verges) and the
@@ -316,6 +325,7 @@ impl VergeEstimator {
             est.verge_deg = gfit.pose.verge().to_degrees();
             est.sigma_deg = gfit.verge_sigma.to_degrees();
             est.angles = None;
+            est.consistent = Vec::new();
             est.pose = Some(gfit.pose.yaw_pitch_roll());
             est.inliers = gfit.inlier_count();
             est.residual_px = gfit.residual_sigma * focal;

@@ -13,6 +13,7 @@ pub mod hil;
 pub mod kalman;
 pub mod link;
 pub mod matching;
+pub mod misalignment;
 pub mod output_dir;
 pub mod plot;
 pub mod ransac;

@@ -184,6 +184,7 @@ mod tests {
                     },
                     truth_deg: Some(v),
                     dropped_because: None,
+                    misalignment: None,
                 }
             })
             .collect();

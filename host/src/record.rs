@@ -5,6 +5,8 @@
 
 use std::fmt;
 
+use crate::misalignment::MisalignmentEstimate;
+
 /// Whether a frame pair produced a measurement.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrameStatus {
@@ -61,4 +63,6 @@ pub struct FrameRecord {
     /// Why a `Dropped` pair was dropped, as the host driver found it (the first damage of
     /// each damaged camera frame, or what never arrived); `None` otherwise.
     pub dropped_because: Option<String>,
+    /// The misalignment window's estimate after this frame, when the session runs one.
+    pub misalignment: Option<MisalignmentEstimate>,
 }

@@ -15,9 +15,10 @@ use stereocal_hdl::FabricConfig;
 
 use crate::calib::Calibration;
 use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome};
-use crate::estimator::{EstimatorConfig, VergeEstimator};
+use crate::estimator::{EstimatorConfig, FrameEstimate, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
 use crate::link::{Device, InProcessLink, LinkError, Threaded};
+use crate::misalignment::{MisalignmentWindow, WindowConfig};
 use crate::record::{FrameRecord, FrameStatus};
 use crate::summary::RunCost;
 
@@ -28,6 +29,9 @@ pub struct SessionConfig {
     pub kalman: KalmanConfig,
     /// Which Sobel output the fabric streams (full rows, as the thesis, or 16x16 patches).
     pub sobel_output: SobelOutput,
+    /// Learn the head's fixed pitch and roll over a sliding window of frames and refit each
+    /// frame's verge with them held (constrained model only); `None`: each frame alone.
+    pub misalignment: Option<WindowConfig>,
 }
 
 impl Default for SessionConfig {
@@ -36,6 +40,7 @@ impl Default for SessionConfig {
             estimator: EstimatorConfig::default(),
             kalman: KalmanConfig::default(),
             sobel_output: SobelOutput::Rows,
+            misalignment: None,
         }
     }
 }
@@ -161,6 +166,7 @@ pub struct Session<D: Device = Threaded> {
     fabric: FabricConfig,
     estimator: VergeEstimator,
     filter: VergeFilter,
+    misalignment: Option<MisalignmentWindow>,
     /// The device's id of the next pair submitted: it numbers frames from 0 after it starts
     /// (the firmware driver's channel), one per pair.
     next_frame_id: u32,
@@ -210,6 +216,9 @@ impl<D: Device> Session<D> {
             driver,
             fabric,
             estimator: VergeEstimator::new(calib, config.estimator),
+            misalignment: config
+                .misalignment
+                .map(|w| MisalignmentWindow::new(&calib.extrinsics, w, config.estimator.refine)),
             filter: VergeFilter::new(config.kalman),
             next_frame_id: 0,
             in_flight: VecDeque::new(),
@@ -420,6 +429,7 @@ impl<D: Device> Session<D> {
             status: FrameStatus::Dropped,
             truth_deg,
             dropped_because: None,
+            misalignment: None,
         };
         record.dropped_because = match &outcome {
             Some(outcome) => damage_of(outcome),
@@ -444,6 +454,7 @@ impl<D: Device> Session<D> {
                 record.status = FrameStatus::NoEstimate;
                 let estimating = Instant::now();
                 let estimate = self.estimator.estimate(&left.features, &right.features);
+                let estimate = estimate.map(|est| self.refit_misaligned(est, &mut record));
                 self.cost.estimating += estimating.elapsed();
                 match estimate {
                     Ok(est) => {
@@ -476,6 +487,26 @@ impl<D: Device> Session<D> {
         }
         self.cost.pairs += 1;
         Ok(record)
+    }
+
+    /// With a misalignment window: hands the frame's consistent matches to it and takes its
+    /// refit verge, recording the window's misalignment estimate. A frame the window cannot
+    /// refit keeps its own estimate.
+    fn refit_misaligned(
+        &mut self,
+        mut est: FrameEstimate,
+        record: &mut FrameRecord,
+    ) -> FrameEstimate {
+        let (Some(window), Some(angles)) = (&mut self.misalignment, est.angles) else {
+            return est;
+        };
+        if let Ok(fit) = window.update(std::mem::take(&mut est.consistent), angles) {
+            est.verge_deg = fit.angles.verge_deg();
+            est.sigma_deg = fit.verge_sigma.to_degrees();
+            est.angles = Some(fit.angles);
+        }
+        record.misalignment = Some(window.estimate());
+        est
     }
 
     fn check_size(

@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 
+use crate::misalignment::MisalignmentEstimate;
 use crate::record::{FrameRecord, FrameStatus};
 
 /// Frames the filter takes to settle after it starts from one raw measurement. Over them its
@@ -49,6 +50,9 @@ pub struct Summary {
     pub median_matches: Option<f64>,
     /// Bytes on the wire per frame pair, both cameras, as measured on the link.
     pub wire_bytes_per_pair: f64,
+    /// The misalignment window's estimate after the last frame it saw, with its 1-σ;
+    /// `null` without a window.
+    pub misalignment: Option<MisalignmentEstimate>,
 }
 
 /// Work measured while producing the records.
@@ -115,6 +119,7 @@ impl Summary {
             filtered_span_deg: span,
             median_matches: median(&matches),
             wire_bytes_per_pair: cost.wire_bytes_per_pair,
+            misalignment: records.iter().rev().find_map(|r| r.misalignment),
         }
     }
 
@@ -163,6 +168,7 @@ mod tests {
             status,
             truth_deg: Some(truth),
             dropped_because: None,
+            misalignment: None,
         }
     }
 

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use crate::record::FrameRecord;
 
-/// Header of `verge.csv`; part of the CLI contract, never reordered.
-pub const VERGE_HEADER: [&str; 7] = [
+/// Header of `verge.csv`; part of the CLI contract, never reordered (new columns go last).
+pub const VERGE_HEADER: [&str; 10] = [
     "frame",
     "raw_verge_deg",
     "filtered_verge_deg",
@@ -15,6 +15,9 @@ pub const VERGE_HEADER: [&str; 7] = [
     "matches",
     "inliers",
     "status",
+    "pitch_deg",
+    "roll_deg",
+    "baseline_tilt_deg",
 ];
 
 /// Header of a ground-truth file.
@@ -55,6 +58,9 @@ pub fn write_verge_csv<W: Write>(out: W, records: &[FrameRecord]) -> Result<(), 
             r.matches.to_string(),
             r.inliers.to_string(),
             r.status.as_str().to_string(),
+            angle(r.misalignment.map(|m| m.pitch_deg)),
+            angle(r.misalignment.map(|m| m.roll_deg)),
+            angle(r.misalignment.map(|m| m.baseline_tilt_deg)),
         ])?;
     }
     w.flush()?;
@@ -121,6 +127,7 @@ pub fn read_truth_csv(path: &Path) -> Result<Vec<f64>, TruthError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::misalignment::MisalignmentEstimate;
     use crate::record::FrameStatus;
 
     #[test]
@@ -138,6 +145,15 @@ mod tests {
                 status: FrameStatus::Ok,
                 truth_deg: None,
                 dropped_because: None,
+                misalignment: Some(MisalignmentEstimate {
+                    pitch_deg: 0.01,
+                    roll_deg: -0.03,
+                    baseline_tilt_deg: 0.0,
+                    pitch_sigma_deg: 0.001,
+                    roll_sigma_deg: 0.002,
+                    baseline_tilt_sigma_deg: 0.0,
+                    frames: 1,
+                }),
             },
             FrameRecord {
                 frame: 1,
@@ -151,6 +167,7 @@ mod tests {
                 status: FrameStatus::NoEstimate,
                 truth_deg: None,
                 dropped_because: None,
+                misalignment: None,
             },
         ];
         let mut out = Vec::new();
@@ -158,9 +175,10 @@ mod tests {
         let text = String::from_utf8(out).unwrap();
         assert_eq!(
             text,
-            "frame,raw_verge_deg,filtered_verge_deg,filtered_sigma_deg,matches,inliers,status\n\
-             0,1.250000,1.200000,0.010000,40,38,ok\n\
-             1,,,,2,0,no_estimate\n"
+            "frame,raw_verge_deg,filtered_verge_deg,filtered_sigma_deg,matches,inliers,status,\
+             pitch_deg,roll_deg,baseline_tilt_deg\n\
+             0,1.250000,1.200000,0.010000,40,38,ok,0.010000,-0.030000,0.000000\n\
+             1,,,,2,0,no_estimate,,,\n"
         );
     }
 

@@ -1,12 +1,13 @@
 //! The estimator's optional modes reach it from the command line and each still measures the
 //! verge: the reduced 16-element descriptor and dominant-orientation rotation (thesis 6.3),
 //! matching without the left-right check or the vertical-disparity gate or with another ratio
-//! or a best-N cut, the solve without RANSAC or with the general five-degree-of-freedom
-//! model, and Sobel patches on the wire. Each must show its effect (so the flag took effect):
-//! a mode of the matcher changes the matches, `--best N` keeps N of them, the solver's modes
-//! keep the matches and change the estimates, and patches cut the wire bytes. None loses a
-//! frame, and every mode keeps the maximum error under 0.05°, except Sobel patches (which
-//! leave the sub-pixel refinement without its octave-0 Sobel plane) under 0.1°.
+//! or a best-N cut, the solve without RANSAC, with the general five-degree-of-freedom model or
+//! with the head's fixed misalignments learned over a window (which reports them), and Sobel
+//! patches on the wire. Each must show its effect (so the flag took effect): a mode of the
+//! matcher changes the matches, `--best N` keeps N of them, the solver's modes keep the
+//! matches and change the estimates, and patches cut the wire bytes. None loses a frame, and
+//! every mode keeps the maximum error under 0.05°, except Sobel patches (which leave the
+//! sub-pixel refinement without its octave-0 Sobel plane) under 0.1°.
 
 use std::process::Command;
 
@@ -76,7 +77,7 @@ impl Effect {
 #[test]
 fn every_optional_mode_estimates_the_verge() {
     let default = eval(&[]);
-    let modes: [(&[&str], Effect, f64); 11] = [
+    let modes: [(&[&str], Effect, f64); 13] = [
         (&["--descriptor", "reduced16"], Effect::OtherMatches, 0.05),
         (&["--rotate"], Effect::OtherMatches, 0.05),
         (&["--no-cross-check"], Effect::OtherMatches, 0.05),
@@ -91,6 +92,16 @@ fn every_optional_mode_estimates_the_verge() {
             Effect::SameMatchesOtherEstimates,
             0.05,
         ),
+        (
+            &["--misalignment", "window"],
+            Effect::SameMatchesOtherEstimates,
+            0.05,
+        ),
+        (
+            &["--misalignment", "window-tilt"],
+            Effect::SameMatchesOtherEstimates,
+            0.05,
+        ),
         (&["--sobel", "patches"], Effect::WireBytesAtMost(0.6), 0.1),
     ];
     for (extra, effect, max_err) in modes {
@@ -102,5 +113,21 @@ fn every_optional_mode_estimates_the_verge() {
             effect.holds(&j, &default),
             "{extra:?}: no {effect:?} in {j} against the default {default}"
         );
+        // The window reports its estimate; the rendered head has no misalignment, and the
+        // baseline's tilt is estimated only when asked.
+        let m = &j["misalignment"];
+        if extra[0] == "--misalignment" {
+            assert_eq!(m["frames"], 8, "{extra:?}: {j}");
+            assert!(number(m, "pitch_deg").abs() < 0.05, "{extra:?}: {m}");
+            assert!(number(m, "roll_deg").abs() < 0.05, "{extra:?}: {m}");
+            let tilt_sigma = number(m, "baseline_tilt_sigma_deg");
+            assert_eq!(
+                tilt_sigma > 0.0,
+                extra[1] == "window-tilt",
+                "{extra:?}: {m}"
+            );
+        } else {
+            assert!(m.is_null(), "{extra:?}: {j}");
+        }
     }
 }

@@ -286,6 +286,7 @@ mod tests {
             status,
             truth_deg: None,
             dropped_because: None,
+            misalignment: None,
         }
     }
 

@@ -1,0 +1,445 @@
+//! The head's fixed misalignments learned online: a sliding-window joint fit over the last
+//! frames' matches, with the right camera's pitch and roll (and optionally the baseline's
+//! tilt) shared by every frame and two yaws per frame.
+//!
+//! One frame cannot tell a small pitch or roll from a change of verge: the thesis' model bends
+//! the verge to explain them, by an amount that depends on where the matches lie, so the
+//! error moves from view to view. Frames with different views constrain the shared angles
+//! jointly, and the current frame's verge is then refitted with them held
+//! ([`misaligned::refine_yaws`]). Each Gauss-Newton step eliminates the per-frame yaws by the
+//! Schur complement, so a step costs one pass over the window's matches and a 3x3 solve. A
+//! frame that leaves the window leaves its information about the shared angles behind, as a
+//! Gaussian prior (marginalisation), so the window bounds the cost, not the memory.
+
+use std::collections::VecDeque;
+
+use nalgebra::{Matrix2, Matrix2x3, Matrix3, SMatrix, SVector, Vector2, Vector3};
+use rayon::prelude::*;
+
+use crate::calib::Extrinsics;
+use crate::essential::constrained::VergeAngles;
+use crate::essential::misaligned::{self, Misalignment, YawFit};
+use crate::essential::{Correspondence, EssentialError, RefineConfig};
+
+/// Which misalignments the window estimates (`--misalignment`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WindowConfig {
+    /// Frames in the window.
+    pub frames: usize,
+    /// Whether the baseline's tilt is estimated too (else held at the calibration's).
+    pub tilt: bool,
+    /// Joint Gauss-Newton steps per new frame.
+    pub steps: usize,
+    /// Frames the prior of the marginalised frames remembers: each frame that leaves the
+    /// window first discounts the prior by `1 - 1/memory`.
+    pub memory: usize,
+}
+
+impl Default for WindowConfig {
+    /// 30 frames: the shared angles' noise falls as 1/√N, to a fifth of one frame's at 30,
+    /// while 30 frames of about 500 matches keep a step near a millisecond on two cores, and
+    /// a misalignment that drifts (temperature, a knock) is forgotten within 30 frames. Two
+    /// steps per frame: every frame stays in the window for 30 frames, so its yaws and the
+    /// shared angles converge over 60 steps; two keep up with a drifting misalignment. A
+    /// memory of 300 frames (half a minute at 10 Hz) lets the shared angles' noise fall to
+    /// about 1/√300 of one frame's, while a misalignment that drifts with temperature, over
+    /// minutes, is still followed.
+    fn default() -> Self {
+        Self {
+            frames: 30,
+            tilt: false,
+            steps: 2,
+            memory: 300,
+        }
+    }
+}
+
+/// The window's current estimate of the misalignments, degrees, with 1-σ from the joint
+/// fit's covariance (0 for an angle held at the calibration's).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct MisalignmentEstimate {
+    pub pitch_deg: f64,
+    pub roll_deg: f64,
+    pub baseline_tilt_deg: f64,
+    pub pitch_sigma_deg: f64,
+    pub roll_sigma_deg: f64,
+    pub baseline_tilt_sigma_deg: f64,
+    /// Frames in the window that gave it.
+    pub frames: usize,
+}
+
+/// One frame in the window: its consistent matches and its current yaws.
+#[derive(Debug, Clone)]
+struct WindowFrame {
+    matches: Vec<Correspondence>,
+    angles: VergeAngles,
+}
+
+/// One frame's Gauss-Newton normal equations, split into its yaws (`a`) and the shared block
+/// (`s`), in units of its own noise (divided by its robust σ²) so that frames of different
+/// quality weigh by their information.
+struct FrameNormal {
+    aa: Matrix2<f64>,
+    as_: Matrix2x3<f64>,
+    ss: Matrix3<f64>,
+    ba: Vector2<f64>,
+    bs: Vector3<f64>,
+}
+
+impl FrameNormal {
+    /// The frame's information and gradient on the shared block with its yaws eliminated
+    /// (Schur complement), and the inverse of its yaw block; `None` when its yaws are not
+    /// determined.
+    fn reduced(&self) -> Option<(Matrix3<f64>, Vector3<f64>, Matrix2<f64>)> {
+        let aa_inv = self.aa.try_inverse()?;
+        let cross = self.as_.transpose() * aa_inv;
+        Some((
+            self.ss - cross * self.as_,
+            self.bs - cross * self.ba,
+            aa_inv,
+        ))
+    }
+}
+
+/// The sliding-window joint estimator of the head's fixed misalignments.
+#[derive(Debug, Clone)]
+pub struct MisalignmentWindow {
+    config: WindowConfig,
+    refine: RefineConfig,
+    shared: Misalignment,
+    covariance: Matrix3<f64>,
+    frames: VecDeque<WindowFrame>,
+    /// What the frames that left the window said about the shared angles: information
+    /// matrix and the angles it centres on.
+    prior_information: Matrix3<f64>,
+    prior_mean: Vector3<f64>,
+}
+
+impl MisalignmentWindow {
+    /// Starts from the calibration's misalignments (zero for a rectified pair).
+    pub fn new(extrinsics: &Extrinsics, config: WindowConfig, refine: RefineConfig) -> Self {
+        Self {
+            config,
+            refine,
+            shared: Misalignment::from_extrinsics(extrinsics),
+            covariance: Matrix3::zeros(),
+            frames: VecDeque::with_capacity(config.frames + 1),
+            prior_information: Matrix3::zeros(),
+            prior_mean: Vector3::zeros(),
+        }
+    }
+
+    /// The current misalignment estimate.
+    pub fn estimate(&self) -> MisalignmentEstimate {
+        let sd = |i: usize| self.covariance[(i, i)].max(0.0).sqrt().to_degrees();
+        MisalignmentEstimate {
+            pitch_deg: self.shared.pitch.to_degrees(),
+            roll_deg: self.shared.roll.to_degrees(),
+            baseline_tilt_deg: self.shared.tilt.to_degrees(),
+            pitch_sigma_deg: sd(0),
+            roll_sigma_deg: sd(1),
+            baseline_tilt_sigma_deg: sd(2),
+            frames: self.frames.len(),
+        }
+    }
+
+    /// Takes a new frame's consistent matches (calibrated, with the estimator's weights) and
+    /// its yaws from the per-frame fit; moves the window on, refines the shared angles, and
+    /// returns the frame's yaws refitted with them held.
+    pub fn update(
+        &mut self,
+        matches: Vec<Correspondence>,
+        start: VergeAngles,
+    ) -> Result<YawFit, EssentialError> {
+        let first = misaligned::refine_yaws(&matches, start, &self.shared, &self.refine)?;
+        self.frames.push_back(WindowFrame {
+            matches,
+            angles: first.angles,
+        });
+        while self.frames.len() > self.config.frames {
+            if let Some(old) = self.frames.pop_front() {
+                self.marginalise(&old);
+            }
+        }
+        for _ in 0..self.config.steps {
+            self.step();
+        }
+        let newest = self.frames.back_mut().ok_or(EssentialError::Degenerate)?;
+        let fit =
+            misaligned::refine_yaws(&newest.matches, newest.angles, &self.shared, &self.refine)?;
+        newest.angles = fit.angles;
+        Ok(fit)
+    }
+
+    /// Folds what `frame` says about the shared angles, its yaws eliminated, into the prior,
+    /// linearised at the current estimate, after discounting the prior by the memory.
+    fn marginalise(&mut self, frame: &WindowFrame) {
+        let Some((info, grad)) = frame_normal(frame, &self.shared, &self.refine)
+            .and_then(|n| n.reduced().map(|(s, g, _)| (s, g)))
+        else {
+            return;
+        };
+        let keep = 1.0 - 1.0 / self.config.memory.max(1) as f64;
+        let old = self.prior_information * keep;
+        let total = old + info;
+        let Some(total_inv) = total.try_inverse() else {
+            return;
+        };
+        let s = self.shared.to_vector();
+        self.prior_mean = total_inv * (old * self.prior_mean + info * s - grad);
+        self.prior_information = total;
+    }
+
+    /// One robust Gauss-Newton step of the joint fit. A shared block the window does not
+    /// constrain (too few frames or views, a singular system) leaves the shared angles and the
+    /// yaws where they are.
+    fn step(&mut self) {
+        let shared = self.shared;
+        let refine = self.refine;
+        let normals: Vec<Option<FrameNormal>> = self
+            .frames
+            .par_iter()
+            .map(|f| frame_normal(f, &shared, &refine))
+            .collect();
+        let mut s = self.prior_information;
+        let mut g = self.prior_information * (self.shared.to_vector() - self.prior_mean);
+        let mut reduced = Vec::with_capacity(normals.len());
+        for n in &normals {
+            match n.as_ref().and_then(FrameNormal::reduced) {
+                Some((sj, gj, aa_inv)) => {
+                    s += sj;
+                    g += gj;
+                    reduced.push(Some(aa_inv));
+                }
+                None => reduced.push(None),
+            }
+        }
+        // Held angles: their rows and columns leave the system.
+        let free = [true, true, self.config.tilt];
+        for (i, &f) in free.iter().enumerate() {
+            if !f {
+                for j in 0..3 {
+                    s[(i, j)] = 0.0;
+                    s[(j, i)] = 0.0;
+                }
+                s[(i, i)] = 1.0;
+                g[i] = 0.0;
+            }
+        }
+        let Some(s_inv) = s.try_inverse() else {
+            return;
+        };
+        let ds = -(s_inv * g);
+        if !ds.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        let mut covariance = s_inv;
+        for (i, &f) in free.iter().enumerate() {
+            if !f {
+                for j in 0..3 {
+                    covariance[(i, j)] = 0.0;
+                    covariance[(j, i)] = 0.0;
+                }
+            }
+        }
+        self.covariance = covariance;
+        self.shared = Misalignment::from_vector(&(self.shared.to_vector() + ds));
+        for ((frame, n), aa_inv) in self.frames.iter_mut().zip(&normals).zip(&reduced) {
+            if let (Some(n), Some(aa_inv)) = (n, aa_inv) {
+                let da = -(aa_inv * (n.ba + n.as_ * ds));
+                frame.angles.alpha_l += da[0];
+                frame.angles.alpha_r += da[1];
+            }
+        }
+    }
+}
+
+/// The normal equations of one frame at the current shared angles (Cauchy IRLS weights on
+/// its own robust scale); `None` when it has no usable residual.
+fn frame_normal(
+    frame: &WindowFrame,
+    shared: &Misalignment,
+    refine: &RefineConfig,
+) -> Option<FrameNormal> {
+    let (e, de) = misaligned::essential_and_derivatives(frame.angles, shared);
+    let rg: Vec<(f64, SVector<f64, 5>)> = frame
+        .matches
+        .iter()
+        .filter_map(|c| {
+            let (r, g) = misaligned::residual_and_gradient(&e, &de, c)?;
+            let s = c.weight.sqrt();
+            Some((r * s, SVector::<f64, 5>::from(g) * s))
+        })
+        .collect();
+    let residuals: Vec<f64> = rg.iter().map(|(r, _)| *r).collect();
+    let sigma = crate::essential::mad_sigma(&residuals, refine.min_sigma);
+    let mut h = SMatrix::<f64, 5, 5>::zeros();
+    let mut b = SVector::<f64, 5>::zeros();
+    for (r, g) in &rg {
+        let w = refine.loss.weight(*r, sigma);
+        h += w * g * g.transpose();
+        b += w * g * *r;
+    }
+    if rg.is_empty() {
+        return None;
+    }
+    let scale = 1.0 / (sigma * sigma);
+    let (h, b) = (h * scale, b * scale);
+    Some(FrameNormal {
+        aa: h.fixed_view::<2, 2>(0, 0).into_owned(),
+        as_: h.fixed_view::<2, 3>(0, 2).into_owned(),
+        ss: h.fixed_view::<3, 3>(2, 2).into_owned(),
+        ba: b.fixed_view::<2, 1>(0, 0).into_owned(),
+        bs: b.fixed_view::<3, 1>(2, 0).into_owned(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::essential::constrained;
+    use crate::essential::testutil::misaligned_synthetic;
+
+    /// A head with a fixed pitch and roll, its verge moving, the view new every frame (new
+    /// points, and each frame sees only part of the field: the per-frame model's error
+    /// depends on where the matches lie). The window recovers the pitch and roll, and its
+    /// verge beats the per-frame model's once it has seen a few views.
+    #[test]
+    fn the_window_learns_a_fixed_pitch_and_roll_and_unbends_the_verge() {
+        let truth = Misalignment {
+            pitch: 0.15f64.to_radians(),
+            roll: 0.1f64.to_radians(),
+            tilt: 0.0,
+        };
+        let (f, noise_px) = (700.0, 0.15);
+        let refine = RefineConfig::default();
+        let mut window =
+            MisalignmentWindow::new(&Extrinsics::default(), WindowConfig::default(), refine);
+        let (mut plain_err, mut window_err) = (Vec::new(), Vec::new());
+        for k in 0..40u64 {
+            let t = k as f64 * 0.4;
+            let a = VergeAngles::new(
+                (1.0 + 0.5 * t.sin()).to_radians(),
+                (-0.5 + 0.4 * (0.7 * t).cos()).to_radians(),
+            );
+            // Half of the field, a different half every frame.
+            let side = [1.0, -1.0][k as usize % 2];
+            let m: Vec<Correspondence> =
+                misaligned_synthetic(a, &truth, 1200, noise_px, f, 100 + k)
+                    .into_iter()
+                    .filter(|c| c.left[(k as usize / 2) % 2] * side > 0.0)
+                    .collect();
+            let plain = constrained::refine(&m, a, &refine).unwrap();
+            let fit = window.update(m, plain.angles).unwrap();
+            if k >= 10 {
+                plain_err.push((plain.angles.verge() - a.verge()).to_degrees().abs());
+                window_err.push((fit.angles.verge() - a.verge()).to_degrees().abs());
+            }
+        }
+        let est = window.estimate();
+        assert!((est.pitch_deg - 0.15).abs() < 0.01, "{est:?}");
+        assert!((est.roll_deg - 0.1).abs() < 0.01, "{est:?}");
+        assert!(
+            est.pitch_sigma_deg > 0.0 && est.pitch_sigma_deg < 0.01,
+            "{est:?}"
+        );
+        assert_eq!((est.baseline_tilt_deg, est.frames), (0.0, 30));
+        let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        assert!(
+            max(&window_err) < 0.05 && mean(&window_err) < 0.1 * mean(&plain_err),
+            "window {:.4}/{:.4}° vs per-frame {:.4}/{:.4}° (mean/max)",
+            mean(&window_err),
+            max(&window_err),
+            mean(&plain_err),
+            max(&plain_err)
+        );
+    }
+
+    /// With the baseline's tilt free too, a tilted baseline is recovered as well.
+    #[test]
+    fn the_window_learns_a_baseline_tilt_when_asked() {
+        let truth = Misalignment {
+            pitch: -0.1f64.to_radians(),
+            roll: 0.05f64.to_radians(),
+            tilt: 0.3f64.to_radians(),
+        };
+        let refine = RefineConfig::default();
+        let config = WindowConfig {
+            tilt: true,
+            ..WindowConfig::default()
+        };
+        let mut window = MisalignmentWindow::new(&Extrinsics::default(), config, refine);
+        for k in 0..30u64 {
+            let a = VergeAngles::new((0.5 + 0.02 * k as f64).to_radians(), -0.3f64.to_radians());
+            let m = misaligned_synthetic(a, &truth, 600, 0.1, 700.0, 200 + k);
+            let plain = constrained::refine(&m, a, &refine).unwrap();
+            window.update(m, plain.angles).unwrap();
+        }
+        let est = window.estimate();
+        assert!((est.pitch_deg + 0.1).abs() < 0.01, "{est:?}");
+        assert!((est.roll_deg - 0.05).abs() < 0.01, "{est:?}");
+        assert!((est.baseline_tilt_deg - 0.3).abs() < 0.05, "{est:?}");
+    }
+
+    /// Frames that leave a short window keep informing the shared angles through the prior:
+    /// with a memory the estimate is as accurate as the long window's and surer than a window
+    /// that forgets them at once.
+    #[test]
+    fn frames_that_leave_the_window_stay_in_its_prior() {
+        let truth = Misalignment {
+            pitch: 0.12f64.to_radians(),
+            roll: -0.08f64.to_radians(),
+            tilt: 0.0,
+        };
+        let refine = RefineConfig::default();
+        let run = |memory: usize| {
+            let config = WindowConfig {
+                frames: 5,
+                memory,
+                ..WindowConfig::default()
+            };
+            let mut window = MisalignmentWindow::new(&Extrinsics::default(), config, refine);
+            for k in 0..40u64 {
+                let a = VergeAngles::new(
+                    (1.0 + 0.3 * (k as f64 * 0.5).sin()).to_radians(),
+                    -0.4f64.to_radians(),
+                );
+                let m = misaligned_synthetic(a, &truth, 400, 0.2, 700.0, 300 + k);
+                let plain = constrained::refine(&m, a, &refine).unwrap();
+                window.update(m, plain.angles).unwrap();
+            }
+            window.estimate()
+        };
+        let (remembering, forgetting) = (run(300), run(1));
+        assert_eq!(remembering.frames, 5);
+        assert!(
+            (remembering.pitch_deg - 0.12).abs() < 0.01,
+            "{remembering:?}"
+        );
+        assert!(
+            (remembering.roll_deg + 0.08).abs() < 0.01,
+            "{remembering:?}"
+        );
+        assert!(
+            remembering.pitch_sigma_deg < 0.6 * forgetting.pitch_sigma_deg,
+            "{remembering:?} vs {forgetting:?}"
+        );
+    }
+
+    /// The window starts from the calibration's misalignments and, without tilt, holds its
+    /// tilt there.
+    #[test]
+    fn the_window_starts_from_the_calibration() {
+        let e = Extrinsics {
+            pitch_deg: 0.2,
+            roll_deg: -0.1,
+            baseline_tilt_deg: 0.05,
+            ..Extrinsics::default()
+        };
+        let w = MisalignmentWindow::new(&e, WindowConfig::default(), RefineConfig::default());
+        let est = w.estimate();
+        assert!((est.pitch_deg - 0.2).abs() < 1e-12 && (est.roll_deg + 0.1).abs() < 1e-12);
+        assert!((est.baseline_tilt_deg - 0.05).abs() < 1e-12 && est.frames == 0);
+    }
+}
