@@ -85,13 +85,18 @@ impl Fixture {
     }
 
     /// `stereocal run` on the fixture's directories, calibration and output, plus `extra`.
-    /// Backtraces are off, as for a user: stderr is the message alone, and no backtrace frame
-    /// (`lifecycle.rs` holds `cy`) can stand in for the culprit's name.
     fn run(&self, extra: &[&str]) -> Output {
+        self.command("run", extra)
+    }
+
+    /// `stereocal COMMAND` on the fixture's directories (as a sequence), calibration and
+    /// output, plus `extra`. Backtraces are off, as for a user: stderr is the message alone,
+    /// and no backtrace frame (`lifecycle.rs` holds `cy`) can stand in for the culprit's name.
+    fn command(&self, command: &str, extra: &[&str]) -> Output {
         Command::new(env!("CARGO_BIN_EXE_stereocal"))
             .env_remove("RUST_BACKTRACE")
             .env_remove("RUST_LIB_BACKTRACE")
-            .arg("run")
+            .arg(command)
             .arg("--left")
             .arg(self.left())
             .arg("--right")
@@ -357,21 +362,7 @@ fn textureless_sequence_gives_no_estimate_rows() {
 impl Fixture {
     /// `stereocal inject` on the fixture's directories as a sequence, writing to `--out`.
     fn inject(&self, extra: &[&str]) -> Output {
-        Command::new(env!("CARGO_BIN_EXE_stereocal"))
-            .env_remove("RUST_BACKTRACE")
-            .env_remove("RUST_LIB_BACKTRACE")
-            .arg("inject")
-            .arg("--left")
-            .arg(self.left())
-            .arg("--right")
-            .arg(self.right())
-            .arg("--calib")
-            .arg(self.calib())
-            .arg("--out")
-            .arg(self.out())
-            .args(extra)
-            .output()
-            .expect("the stereocal binary runs")
+        self.command("inject", extra)
     }
 }
 
