@@ -290,8 +290,8 @@ def main():
                         "eth3d_two_view")
     if not os.path.isfile(os.path.join(data, "geometry.json")):
         raise SystemExit(f"no real data at {data} (set STEREOCAL_REAL_DATA)")
-    print("building stereocal (cargo build --release -p stereocal)", file=sys.stderr)
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal"], cwd=ROOT, check=True)
+    print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal-cli"], cwd=ROOT, check=True)
     binary = os.path.join(ROOT, "target", "release", "stereocal")
     geometry = json.load(open(os.path.join(data, "geometry.json")))["scenes"]
 

@@ -317,8 +317,8 @@ def main():
     data = os.environ.get("STEREOCAL_REAL_DATA", os.path.join(ROOT, "..", "shared", "data", "real"))
     if not os.path.isdir(data):
         raise SystemExit(f"no real data at {data} (set STEREOCAL_REAL_DATA)")
-    print("building stereocal (cargo build --release -p stereocal)", file=sys.stderr)
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal"], cwd=ROOT, check=True)
+    print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal-cli"], cwd=ROOT, check=True)
     binary = os.path.join(ROOT, "target", "release", "stereocal")
     if args.csv:
         os.makedirs(args.csv, exist_ok=True)

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 frames=${1:-60}
 data=${STEREOCAL_REAL_DATA:-../shared/data/real}/eth3d_two_view
 [ -f "$data/geometry.json" ] || { echo "no real data at $data (set STEREOCAL_REAL_DATA)" >&2; exit 1; }
-cargo build --release -q -p stereocal
+cargo build --release -q -p stereocal-cli
 bin=target/release/stereocal
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

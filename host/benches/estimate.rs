@@ -13,7 +13,7 @@ use std::hint::black_box;
 use stereocal::calib::{Calibration, CameraIntrinsics, Extrinsics};
 use stereocal::descriptor::{describe, DescriptorConfig};
 use stereocal::estimator::{EstimatorConfig, VergeEstimator};
-use stereocal::frame::{FeatureFrame, Gradients, Keypoint, SobelPlane};
+use stereocal::features::{FeatureFrame, Gradients, Keypoint, SobelPlane};
 use stereocal::kalman::{KalmanConfig, Measurement, VergeFilter};
 use stereocal::matching::{match_descriptors, MatchConfig};
 use stereocal::subpixel::{refine_pair, SubpixelConfig};

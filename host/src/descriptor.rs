@@ -13,7 +13,7 @@
 //! two views are not rotated against each other, and skipping the rotation both saves work
 //! and removes a source of mismatches (thesis 6.3).
 
-use crate::frame::{FeatureFrame, ORIENTATION_STEPS, PATCH_SIZE};
+use crate::features::{FeatureFrame, ORIENTATION_STEPS, PATCH_SIZE};
 
 /// Descriptor layout.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -365,7 +365,7 @@ fn round_to_u8(x: f32) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::{Gradients, Keypoint, SobelPlane};
+    use crate::features::{Gradients, Keypoint, SobelPlane};
 
     /// A synthetic gradient plane: orientation and magnitude from a smooth pseudo-random field.
     fn plane(width: u32, height: u32, shift_x: i32, rotate_quarter: bool) -> SobelPlane {

@@ -145,26 +145,6 @@ mod tests {
     }
 
     #[test]
-    fn synth_writes_the_truth_as_run_reads_it() {
-        use crate::synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
-        let config = SequenceConfig {
-            frames: 40,
-            seed: 10,
-            trajectory: TrajectoryKind::Motor,
-            ..SequenceConfig::for_scene(SceneKind::Road)
-        };
-        let sequence = Sequence::builtin(SceneKind::Road, config).unwrap();
-        let (verge, _) = read(&sequence.encoders_csv(), 40);
-        for (i, v) in verge.unwrap().into_iter().enumerate() {
-            let truth = sequence.truth(i).unwrap().verge_deg;
-            assert!(
-                (v.unwrap() - truth).abs() < 1e-8,
-                "frame {i}: {v:?} vs {truth}"
-            );
-        }
-    }
-
-    #[test]
     fn bad_files_name_the_line_and_field() {
         let (r, m) = read(
             "frame,left_yaw_deg,right_yaw_deg\n0,1.5,-0.5\n1,1.5,abc\n",

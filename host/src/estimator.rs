@@ -16,7 +16,7 @@ use crate::descriptor::{describe, DescriptorConfig};
 use crate::essential::constrained::{self, VergeAngles};
 use crate::essential::general::{self, RelativePose, YawPitchRoll};
 use crate::essential::{cauchy_cost, Correspondence, EssentialError, RefineConfig};
-use crate::frame::{FeatureFrame, Keypoint, SobelPlane};
+use crate::features::{FeatureFrame, Keypoint, SobelPlane};
 use crate::matching::{match_descriptors, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
 use crate::subpixel::{guided_pair, refine_pair, RefinedPair, SubpixelConfig};

@@ -14,7 +14,7 @@
 use rayon::prelude::*;
 
 use crate::descriptor::DescriptorSet;
-use crate::frame::Keypoint;
+use crate::features::Keypoint;
 
 /// Matching settings; the default is the most accurate for a verge head.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -198,7 +198,7 @@ pub fn match_descriptors(
 mod tests {
     use super::*;
     use crate::descriptor::{describe, DescriptorConfig};
-    use crate::frame::{FeatureFrame, Gradients, SobelPlane};
+    use crate::features::{FeatureFrame, Gradients, SobelPlane};
     use proptest::prelude::*;
 
     /// A plane whose gradient at `(x, y)` is drawn from `hash(x, y)`.

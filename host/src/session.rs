@@ -19,8 +19,8 @@ use crate::estimator::{EstimatorConfig, FrameEstimate, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
 use crate::link::{Device, InProcessLink, LinkError, Threaded};
 use crate::misalignment::{MisalignmentWindow, WindowConfig};
-use crate::record::{FrameRecord, FrameStatus};
-use crate::summary::RunCost;
+use crate::output::record::{FrameRecord, FrameStatus};
+use crate::output::summary::RunCost;
 
 /// Settings of a session.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -15,7 +15,7 @@
 
 use std::cell::Cell;
 
-use crate::frame::SobelPlane;
+use crate::features::SobelPlane;
 
 /// Settings of the refinement.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -9,7 +9,7 @@ use driver_fixture::{frame_packets, pattern, point, FrameSpec, Sobel, Wire};
 use stereocal::driver::{
     ContentError, Damage, Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame,
 };
-use stereocal::frame::Gradients;
+use stereocal::features::Gradients;
 use stereocal::link::{LinkError, ReplayLink};
 use stereocal_wire::{Camera, PacketKind};
 

@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use stereocal::driver::{Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame};
-use stereocal::frame::Gradients;
+use stereocal::features::Gradients;
 use stereocal::link::{InProcessLink, Link};
 use stereocal_firmware::fabric::{run_frame, Config, Extremum, FastFrontEnd, SobelPixel, SobelRun};
 use stereocal_hdl::regs::output_mode::SobelOutput;

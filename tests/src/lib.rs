@@ -27,12 +27,12 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use stereocal::calib::Calibration;
-use stereocal::eval::{fabric_size, sequence_calibration};
-use stereocal::hil::{run_on_qemu, HilError, QemuConfig, QemuRun, DEFAULT_QEMU};
 use stereocal::link::{Device, InProcessLink, Recording};
-use stereocal::record::FrameRecord;
+use stereocal::output::record::FrameRecord;
 use stereocal::session::{Session, SessionConfig, SessionError};
-use stereocal::synth::{SceneKind, Sequence, SequenceConfig};
+use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
+use stereocal_tools::eval::{fabric_size, sequence_calibration};
+use stereocal_tools::hil::{run_on_qemu, HilError, QemuConfig, QemuRun, DEFAULT_QEMU};
 use stereocal_wire::{decode, Capabilities, PacketRepr, DELIMITER};
 
 /// One stereo pair.
@@ -117,8 +117,8 @@ impl Scenario {
     }
 
     /// The frames as the soft-core's frame-grabber input.
-    pub fn grabber_input(&self) -> stereocal::hil::GrabberInput {
-        let mut input = stereocal::hil::GrabberInput::new(self.width, self.height);
+    pub fn grabber_input(&self) -> stereocal_tools::hil::GrabberInput {
+        let mut input = stereocal_tools::hil::GrabberInput::new(self.width, self.height);
         for p in &self.pairs {
             input
                 .push_pair(&p.left, &p.right, p.timestamp_us)

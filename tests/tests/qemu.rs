@@ -9,21 +9,21 @@
 use std::time::Duration;
 
 use stereocal::driver::Driver;
-use stereocal::eval::{evaluate, EvalError};
-use stereocal::hil::{
-    instruction_reports, kernel_report, run_on_qemu, run_sequence, FirmwareExit, GrabberInput,
-    HilError, QemuConfig, TimeoutKind,
-};
-use stereocal::record::FrameStatus;
+use stereocal::output::record::FrameStatus;
+use stereocal::output::summary::{Residual, RunCost, Summary};
 use stereocal::session::{fabric_config, SessionConfig, SessionError};
-use stereocal::summary::{Residual, RunCost, Summary};
-use stereocal::synth::{SceneKind, Sequence, SequenceConfig};
 use stereocal_firmware::softcore::finisher::ExitCode;
 use stereocal_firmware::softcore::stack::StackReport;
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hil::{
     assert_same_records, assert_same_stream, qemu_or_skip, real_data_or_skip, run_in_process,
     run_qemu, Scenario,
+};
+use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
+use stereocal_tools::eval::{evaluate, EvalError};
+use stereocal_tools::hil::{
+    instruction_reports, kernel_report, run_on_qemu, run_sequence, FirmwareExit, GrabberInput,
+    HilError, QemuConfig, TimeoutKind,
 };
 
 /// Runs `scenario` both ways and checks bytes and records; prints the figures.

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use stereocal::sequence::decode_gray;
+use stereocal::image_sequence::decode_gray;
 
 const NAMES: [&str; 5] = ["fuzz.png", "fuzz.pgm", "fuzz.jpg", "fuzz.jpeg", "fuzz"];
 

@@ -23,9 +23,9 @@ use std::time::Duration;
 use libfuzzer_sys::fuzz_target;
 use stereocal::calib::Calibration;
 use stereocal::link::{InProcessLink, OwnCameras, Recording, ReplayLink};
-use stereocal::record::FrameStatus;
+use stereocal::output::record::FrameStatus;
 use stereocal::session::{Session, SessionConfig};
-use stereocal::synth::{SceneKind, Sequence, SequenceConfig};
+use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
 use stereocal_wire::DELIMITER;
 
 const W: u16 = 128;
@@ -133,7 +133,7 @@ fn edited(packets: &[Vec<u8>], edits: &[u8]) -> Vec<Vec<u8>> {
     packets
 }
 
-fn check(record: &stereocal::record::FrameRecord, frame: usize) {
+fn check(record: &stereocal::output::record::FrameRecord, frame: usize) {
     assert_eq!(record.frame, frame);
     let measured = [
         record.raw_verge_deg,

@@ -20,7 +20,7 @@ use super::damage::{ContentError, Damage, PacketRef};
 use super::gradients::{FinishError, GradientBuilder};
 use super::keypoint::keypoint;
 use super::stats::LinkStats;
-use crate::frame::{FeatureFrame, Keypoint};
+use crate::features::{FeatureFrame, Keypoint};
 use stereocal_firmware::fabric::geometry::octave_dims;
 
 /// A camera frame that arrived complete and consistent.

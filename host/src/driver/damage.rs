@@ -4,7 +4,7 @@ use std::fmt;
 
 use stereocal_wire::{Camera, PacketKind};
 
-use crate::frame::FrameError;
+use crate::features::FrameError;
 
 /// A packet, identified the way a log line needs it: kind, sequence number, frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

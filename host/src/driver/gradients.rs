@@ -1,4 +1,4 @@
-//! Collects a frame's Sobel packets into the gradient data of a [`FeatureFrame`](crate::frame::FeatureFrame).
+//! Collects a frame's Sobel packets into the gradient data of a [`FeatureFrame`](crate::features::FeatureFrame).
 //!
 //! Rows mode: one plane per octave, every row exactly once. Patches mode: one 16x16 window
 //! per point, matched to its point by `point_index` (a patch may arrive before its point's
@@ -11,7 +11,7 @@ use stereocal_wire::{
 };
 
 use super::damage::ContentError;
-use crate::frame::{FrameError, Gradients, Keypoint, SobelPatch, SobelPlane};
+use crate::features::{FrameError, Gradients, Keypoint, SobelPatch, SobelPlane};
 
 /// Pixels [`split_pixels`] handles per step: a multiple of the SIMD width, and long enough
 /// that the per-step slicing is small next to the copying.

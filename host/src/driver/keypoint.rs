@@ -7,7 +7,7 @@
 
 use stereocal_wire::{Point, OFFSET_FRAC_BITS};
 
-use crate::frame::Keypoint;
+use crate::features::Keypoint;
 
 /// One unit of a Q2.13 offset.
 const OFFSET_ONE: f32 = (1u32 << OFFSET_FRAC_BITS) as f32;

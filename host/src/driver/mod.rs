@@ -1,5 +1,5 @@
 //! The host side of the link: Hello, configuration, and camera frames reassembled from wire
-//! packets into [`FeatureFrame`](crate::frame::FeatureFrame)s.
+//! packets into [`FeatureFrame`](crate::features::FeatureFrame)s.
 //!
 //! ```no_run
 //! # use std::time::Duration;

@@ -15,7 +15,7 @@
 //! | Unix socket (QEMU `-chardev socket,path=..`) | [`UnixLink`] | [`StreamLink::unix`] |
 //! | a byte capture played back | [`ReplayLink`] | [`ReplayLink::new`], [`ReplayLink::from_file`] |
 //! | any link above, its received bytes damaged by seed | [`FaultLink`] | [`FaultLink::new`] |
-//! | the firmware ELF under `qemu-system-riscv32` | [`QemuDevice`](crate::hil::QemuDevice) | [`QemuDevice::start`](crate::hil::QemuDevice::start) |
+//! | the firmware ELF under `qemu-system-riscv32` | [`QemuDevice`](stereocal_tools::hil::QemuDevice) | [`QemuDevice::start`](stereocal_tools::hil::QemuDevice::start) |
 //!
 //! A link that also takes camera frames is a [`Device`]: what a session runs on. A head that
 //! grabs its own frames (a board, an emulator started by hand) is one through [`OwnCameras`].

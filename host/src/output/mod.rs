@@ -1,0 +1,9 @@
+//! What a run leaves behind: one record per pair, and the files written from them
+//! (`verge.csv`, `verge.png`, `summary.json`), each staged and moved into place whole.
+
+pub mod output_dir;
+pub mod plot;
+pub mod record;
+pub mod report;
+pub mod summary;
+pub mod verge_csv;

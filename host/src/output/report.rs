@@ -1,0 +1,135 @@
+//! What a run leaves behind: `verge.csv` and `verge.png` in the output directory (both or
+//! neither), and the human-readable summary table.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::output::output_dir::{OutputError, StagedOutput};
+use crate::output::plot::{draw_verge_plot, PlotError};
+use crate::output::record::FrameRecord;
+use crate::output::summary::Summary;
+use crate::output::verge_csv::write_verge_csv;
+
+/// Output files that could not be written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReportError {
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    #[error("{path}: cannot write the verge CSV: {source}")]
+    Csv { path: PathBuf, source: csv::Error },
+    #[error("{path}: cannot create the verge CSV: {source}")]
+    Create {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Writes `verge.csv` and `verge.png` into `dir`; they appear together, or not at all.
+pub fn write_outputs(
+    dir: &Path,
+    records: &[FrameRecord],
+    title: &str,
+) -> Result<Vec<PathBuf>, ReportError> {
+    let mut staged = StagedOutput::new(dir)?;
+    let csv_path = staged.path("verge.csv");
+    let file = std::fs::File::create(&csv_path).map_err(|source| ReportError::Create {
+        path: dir.join("verge.csv"),
+        source,
+    })?;
+    write_verge_csv(std::io::BufWriter::new(file), records).map_err(|source| ReportError::Csv {
+        path: dir.join("verge.csv"),
+        source,
+    })?;
+    let png_path = staged.path("verge.png");
+    draw_verge_plot(&png_path, records, title).map_err(|e| PlotError {
+        path: dir.join("verge.png"),
+        ..e
+    })?;
+    Ok(staged.commit()?)
+}
+
+/// Extra lines of the summary table that the JSON summary does not carry.
+#[derive(Debug, Clone, Default)]
+pub struct TableExtras {
+    /// (label, value) rows printed after the standard ones.
+    pub rows: Vec<(String, String)>,
+}
+
+/// The summary as an aligned two-column table.
+pub fn summary_table(summary: &Summary, truth_known: bool, extras: &TableExtras) -> String {
+    let deg = |v: Option<f64>| v.map_or("-".to_string(), |d| format!("{d:.4}°"));
+    let mut rows: Vec<(String, String)> = vec![
+        ("frames".into(), summary.frames.to_string()),
+        (
+            "estimated".into(),
+            format!(
+                "{} ({:.1}%)",
+                summary.estimated_frames,
+                100.0 * summary.estimated_fraction()
+            ),
+        ),
+        ("dropped".into(), summary.dropped_frames.to_string()),
+        (
+            "median matches".into(),
+            summary
+                .median_matches
+                .map_or("-".into(), |m| format!("{m:.0}")),
+        ),
+    ];
+    if truth_known {
+        rows.extend([
+            (
+                "raw |error| median / p95 / max".into(),
+                format!(
+                    "{} / {} / {}",
+                    deg(summary.median_abs_err_deg),
+                    deg(summary.p95_abs_err_deg),
+                    deg(summary.max_abs_err_deg)
+                ),
+            ),
+            (
+                "filtered |error| median / max".into(),
+                format!(
+                    "{} / {}",
+                    deg(summary.filtered_median_abs_err_deg),
+                    deg(summary.filtered_max_abs_err_deg)
+                ),
+            ),
+        ]);
+        if summary.residual_removed_deg != 0.0 {
+            rows.push((
+                "constant residual removed".into(),
+                format!("{:.4}°", summary.residual_removed_deg),
+            ));
+        }
+    }
+    rows.extend([
+        (
+            "filtered span (settled)".into(),
+            deg(summary.filtered_span_deg),
+        ),
+        (
+            "ms per frame pair".into(),
+            format!("{:.2}", summary.ms_per_frame_pair),
+        ),
+        (
+            "bytes on the wire per pair".into(),
+            format!("{:.0}", summary.wire_bytes_per_pair),
+        ),
+    ]);
+    rows.extend(extras.rows.iter().cloned());
+    let width = rows
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0);
+    let mut out = String::new();
+    for (k, v) in rows {
+        // Writing to a String cannot fail.
+        let _ = writeln!(out, "  {k:<width$}  {v}");
+    }
+    out
+}

@@ -1,0 +1,405 @@
+//! The firmware ELF on an emulated soft-core: `qemu-system-riscv32 -machine virt` as a
+//! [`Device`].
+//!
+//! [`QemuDevice::start`] writes the pairs into a frame-grabber file, starts QEMU with that
+//! file loaded at the soft-core's frame region and the UART on a Unix socket, and connects to
+//! the socket. From then on it is a link like any other: the host driver says Hello, writes
+//! the configuration, sets `CONTROL.ENABLE`, and reads the frames' packets. The command line:
+//!
+//! ```text
+//! qemu-system-riscv32 -machine virt -m 128M -bios none -display none -monitor none
+//!     -kernel ELF -chardev socket,id=uart,path=DIR/uart.sock,server=on,wait=on
+//!     -serial chardev:uart -device loader,file=DIR/frames.bin,addr=0x81000000
+//!     [-icount shift=0]
+//! ```
+//! `wait=on` holds the machine until the host is connected, so no byte is lost; a socket and
+//! not `-nographic`, whose monitor multiplexer eats `0x01` bytes. `-icount shift=0` (with
+//! [`QemuConfig::count_instructions`]) makes `minstret` count retired instructions, one per
+//! nanosecond of virtual time, so instruction counts are the same on every run.
+//!
+//! Every byte the UART sends is kept in a transcript. The run ends with [`QemuDevice::finish`]
+//! (read to the end, wait for the firmware's exit through the `sifive_test` finisher) or, on
+//! any error, [`QemuDevice::abort`]; dropping the device kills QEMU, so no error path leaves
+//! an emulator behind.
+
+use std::io::{self, Read};
+use std::os::unix::net::UnixStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use stereocal_firmware::softcore::frame_input::VIRT_FRAME_REGION;
+
+use super::input::PairDigest;
+use super::{FirmwareExit, GrabberInput, HilError, TimeoutKind};
+use stereocal::link::{Device, Link, LinkError, Recording, StreamLink, UnixLink};
+
+/// The emulator, found on `PATH` unless [`QemuConfig::qemu`] says otherwise.
+pub const DEFAULT_QEMU: &str = "qemu-system-riscv32";
+
+/// How often the host looks again at the socket (while QEMU starts) or the process (while it ends).
+const POLL: Duration = Duration::from_millis(10);
+/// How long a firmware that failed gets to end the simulation itself before it is killed:
+/// its exit code says more than a kill does.
+const ABORT_GRACE: Duration = Duration::from_secs(1);
+/// How long [`QemuDevice::abort`] reads the bytes left in the socket.
+const ABORT_DRAIN: Duration = Duration::from_millis(200);
+/// Bytes asked of the socket per read when draining it.
+const READ_CHUNK: usize = 64 * 1024;
+
+/// The timeouts of a run; an error names the one that fired ([`TimeoutKind`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct QemuTimeouts {
+    /// QEMU to open its UART socket.
+    pub startup: Duration,
+    /// One answer or one frame pair. A 640x480 pair takes a few seconds under QEMU's
+    /// translator on this project's 2-core machines; the default leaves room for a loaded
+    /// machine and `-icount`.
+    pub answer: Duration,
+    /// The firmware to end the simulation after the last frame.
+    pub exit: Duration,
+}
+
+impl Default for QemuTimeouts {
+    fn default() -> Self {
+        Self {
+            startup: Duration::from_secs(10),
+            answer: Duration::from_secs(120),
+            exit: Duration::from_secs(30),
+        }
+    }
+}
+
+/// How to run the firmware.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct QemuConfig {
+    /// The QEMU binary.
+    pub qemu: PathBuf,
+    /// The firmware ELF (`target/riscv32imc-unknown-none-elf/release/stereocal-firmware`).
+    pub elf: PathBuf,
+    /// Run with `-icount shift=0` and have the firmware log every image's instruction counts.
+    pub count_instructions: bool,
+    /// The timeouts.
+    pub timeouts: QemuTimeouts,
+}
+
+impl QemuConfig {
+    /// The firmware at `elf`, the default QEMU and timeouts, no instruction counts.
+    pub fn new(elf: impl Into<PathBuf>) -> Self {
+        Self {
+            qemu: DEFAULT_QEMU.into(),
+            elf: elf.into(),
+            count_instructions: false,
+            timeouts: QemuTimeouts::default(),
+        }
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct QemuEnd {
+    /// QEMU's exit status, read as the firmware's exit code.
+    pub exit: FirmwareExit,
+    /// Every byte the firmware sent on its UART.
+    pub transcript: Vec<u8>,
+    /// What QEMU printed on stderr.
+    pub stderr: String,
+}
+
+/// The QEMU process; dropping it kills a QEMU that is still running.
+struct Process {
+    child: Child,
+    stderr: Option<JoinHandle<String>>,
+}
+
+impl Process {
+    /// How QEMU ended, if it has.
+    fn try_exit(&mut self) -> Option<FirmwareExit> {
+        match self.child.try_wait() {
+            Ok(Some(status)) => Some(FirmwareExit::from_status(status)),
+            Ok(None) => None,
+            // The child cannot be waited for: it is not running as far as we can tell.
+            Err(_) => Some(FirmwareExit::Signal),
+        }
+    }
+
+    /// Waits for QEMU to end until `deadline`.
+    fn wait_until(&mut self, deadline: Instant) -> Option<FirmwareExit> {
+        loop {
+            if let Some(exit) = self.try_exit() {
+                return Some(exit);
+            }
+            if Instant::now() >= deadline {
+                return None;
+            }
+            std::thread::sleep(POLL);
+        }
+    }
+
+    /// Kills QEMU (if it still runs) and reaps it.
+    fn kill(&mut self) -> FirmwareExit {
+        if let Some(exit) = self.try_exit() {
+            return exit;
+        }
+        // A kill can only fail when the process is already gone; `wait` reaps it either way.
+        let _ = self.child.kill();
+        match self.child.wait() {
+            Ok(status) => FirmwareExit::from_status(status),
+            Err(_) => FirmwareExit::Signal,
+        }
+    }
+
+    /// What QEMU printed on stderr, less its note that it waits for the socket's client
+    /// (printed on every run); only call once it has ended (the reader runs to EOF).
+    fn stderr(&mut self) -> String {
+        let text = self
+            .stderr
+            .take()
+            .and_then(|reader| reader.join().ok())
+            .unwrap_or_default();
+        text.lines()
+            .filter(|line| !line.contains("QEMU waiting for connection"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+}
+
+impl Drop for Process {
+    fn drop(&mut self) {
+        self.kill();
+    }
+}
+
+/// The firmware under QEMU, connected over the UART socket.
+pub struct QemuDevice {
+    // Field order is drop order: the link closes, QEMU is killed, then the directory with
+    // the socket and the frame file goes.
+    link: Recording<UnixLink>,
+    process: Process,
+    loaded: Vec<PairDigest>,
+    submitted: usize,
+    timeouts: QemuTimeouts,
+    _dir: tempfile::TempDir,
+}
+
+impl QemuDevice {
+    /// Writes `input` into a frame-grabber file, starts QEMU on `config.elf` with it and
+    /// connects to the UART. The firmware then waits for the host's Hello and configuration.
+    pub fn start(config: &QemuConfig, input: &GrabberInput) -> Result<Self, HilError> {
+        let elf_readable = std::fs::File::open(&config.elf).map(drop);
+        elf_readable.map_err(|source| HilError::File {
+            path: config.elf.clone(),
+            source,
+        })?;
+        let dir = tempfile::Builder::new()
+            .prefix("stereocal-hil-")
+            .tempdir()
+            .map_err(|source| HilError::File {
+                path: std::env::temp_dir(),
+                source,
+            })?;
+        let frames = dir.path().join("frames.bin");
+        std::fs::write(&frames, input.to_bytes(config.count_instructions)).map_err(|source| {
+            HilError::File {
+                path: frames.clone(),
+                source,
+            }
+        })?;
+        let socket = dir.path().join("uart.sock");
+
+        let mut command = Command::new(&config.qemu);
+        command
+            .args(["-machine", "virt", "-m", "128M", "-bios", "none"])
+            .args(["-display", "none", "-monitor", "none"])
+            .arg("-kernel")
+            .arg(&config.elf)
+            .arg("-chardev")
+            .arg(format!(
+                "socket,id=uart,path={},server=on,wait=on",
+                option_value(&socket)
+            ))
+            .args(["-serial", "chardev:uart"])
+            .arg("-device")
+            .arg(format!(
+                "loader,file={},addr={VIRT_FRAME_REGION:#x}",
+                option_value(&frames)
+            ));
+        if config.count_instructions {
+            command.args(["-icount", "shift=0"]);
+        }
+        let mut child = command
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .map_err(|source| HilError::Spawn {
+                program: config.qemu.clone(),
+                source,
+            })?;
+        let stderr = child.stderr.take().map(|mut pipe| {
+            std::thread::spawn(move || {
+                let mut text = String::new();
+                // Whatever could be read is what QEMU said; a broken pipe ends it.
+                let _ = pipe.read_to_string(&mut text);
+                text
+            })
+        });
+        let mut process = Process { child, stderr };
+
+        let deadline = Instant::now() + config.timeouts.startup;
+        let stream = loop {
+            if let Some(exit) = process.try_exit() {
+                return Err(HilError::EndedEarly {
+                    exit,
+                    stderr: process.stderr(),
+                });
+            }
+            match UnixStream::connect(&socket) {
+                Ok(stream) => break stream,
+                Err(_) if Instant::now() < deadline => std::thread::sleep(POLL),
+                Err(_) => {
+                    return Err(HilError::Timeout {
+                        kind: TimeoutKind::Startup,
+                        limit: config.timeouts.startup,
+                        waiting_for: format!("QEMU to open its UART socket {}", socket.display()),
+                    })
+                }
+            }
+        };
+        Ok(Self {
+            link: Recording::new(StreamLink::from_stream(
+                stream,
+                format!("QEMU UART {}", socket.display()),
+            )),
+            process,
+            loaded: input.digests.clone(),
+            submitted: 0,
+            timeouts: config.timeouts,
+            _dir: dir,
+        })
+    }
+
+    /// Ends a run that went well: reads the UART to its end and waits for the firmware to
+    /// end the simulation ([`QemuTimeouts::exit`]).
+    pub fn finish(mut self) -> Result<QemuEnd, HilError> {
+        let limit = self.timeouts.exit;
+        let deadline = Instant::now() + limit;
+        let timeout = |waiting_for: &str| HilError::Timeout {
+            kind: TimeoutKind::Exit,
+            limit,
+            waiting_for: waiting_for.into(),
+        };
+        let mut buf = vec![0; READ_CHUNK];
+        loop {
+            match self.recv(&mut buf, deadline) {
+                Ok(_) => {}
+                Err(LinkError::Closed { .. }) => break,
+                Err(LinkError::Timeout { .. }) => {
+                    return Err(timeout(
+                        "the firmware to close its UART after the last frame",
+                    ))
+                }
+                Err(e) => return Err(e.into()),
+            }
+        }
+        let exit = self
+            .process
+            .wait_until(deadline)
+            .ok_or_else(|| timeout("QEMU to exit after its UART closed"))?;
+        Ok(QemuEnd {
+            exit,
+            transcript: self.link.take_received(),
+            stderr: self.process.stderr(),
+        })
+    }
+
+    /// Ends a run that failed: gives a failing firmware a moment to end the simulation with
+    /// its own exit code, kills QEMU otherwise, and keeps the bytes it had sent.
+    pub fn abort(mut self) -> QemuEnd {
+        let exit = self
+            .process
+            .wait_until(Instant::now() + ABORT_GRACE)
+            .unwrap_or_else(|| self.process.kill());
+        let deadline = Instant::now() + ABORT_DRAIN;
+        let mut buf = vec![0; READ_CHUNK];
+        while self.recv(&mut buf, deadline).is_ok() {}
+        QemuEnd {
+            exit,
+            transcript: self.link.take_received(),
+            stderr: self.process.stderr(),
+        }
+    }
+}
+
+/// A path as a QEMU option value: a comma there would end the value, `,,` is a literal one.
+fn option_value(path: &Path) -> String {
+    path.display().to_string().replace(',', ",,")
+}
+
+impl Link for QemuDevice {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        self.link.send(bytes)
+    }
+
+    fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
+        self.link.recv(buf, deadline)
+    }
+}
+
+impl Device for QemuDevice {
+    /// The pairs were loaded at boot; this only checks that the host asks for the pair the
+    /// firmware will run next, so host records and device frames cannot drift apart.
+    fn submit_pair(
+        &mut self,
+        left: &[u8],
+        right: &[u8],
+        timestamp_us: u64,
+    ) -> Result<(), LinkError> {
+        let digest = PairDigest::of(left, right, timestamp_us);
+        if self.loaded.get(self.submitted) != Some(&digest) {
+            return Err(LinkError::Io {
+                link: self.link.inner().name().into(),
+                source: io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!(
+                        "pair {} is not the one loaded into the frame region at boot \
+                         ({} pairs were loaded)",
+                        self.submitted,
+                        self.loaded.len()
+                    ),
+                ),
+            });
+        }
+        self.submitted += 1;
+        Ok(())
+    }
+
+    fn answer_timeout(&self) -> Duration {
+        self.timeouts.answer
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn commas_in_paths_are_doubled_for_qemu() {
+        assert_eq!(option_value(Path::new("/tmp/a,b/f")), "/tmp/a,,b/f");
+    }
+
+    #[test]
+    fn a_missing_emulator_is_named() {
+        let elf = tempfile::NamedTempFile::new().unwrap();
+        let config = QemuConfig {
+            qemu: "/nonexistent/qemu-system-riscv32".into(),
+            ..QemuConfig::new(elf.path())
+        };
+        let err = QemuDevice::start(&config, &GrabberInput::new(4, 2))
+            .err()
+            .unwrap();
+        assert!(matches!(err, HilError::Spawn { .. }), "{err}");
+        assert!(err.to_string().contains("qemu-system-misc"), "{err}");
+    }
+}
