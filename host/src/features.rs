@@ -15,10 +15,10 @@ pub const PATCH_SIZE: usize = 16;
 /// Number of orientation codes of the fabric (6 bits).
 pub const ORIENTATION_STEPS: u8 = 64;
 
-/// Why a frame could not be assembled.
+/// Why a camera frame's features could not be assembled.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[non_exhaustive]
-pub enum FrameError {
+pub enum FeatureError {
     #[error(
         "Sobel plane of octave {octave}: {len} magnitude/orientation samples for {width}x{height}"
     )]
@@ -85,7 +85,7 @@ impl SobelPlane {
         height: u32,
         magnitude: Vec<u8>,
         orientation: Vec<u8>,
-    ) -> Result<Self, FrameError> {
+    ) -> Result<Self, FeatureError> {
         // One branch-free OR over the plane (it vectorises), where searching for the first
         // bad code took a compare and branch per pixel; the search only runs on a bad plane.
         let codes = orientation.iter().fold(0, |ored, &code| ored | code);
@@ -104,10 +104,10 @@ impl SobelPlane {
         magnitude: Vec<u8>,
         orientation: Vec<u8>,
         codes: u8,
-    ) -> Result<Self, FrameError> {
+    ) -> Result<Self, FeatureError> {
         let n = width as usize * height as usize;
         if magnitude.len() != n || orientation.len() != n {
-            return Err(FrameError::PlaneSize {
+            return Err(FeatureError::PlaneSize {
                 octave,
                 width,
                 height,
@@ -120,7 +120,7 @@ impl SobelPlane {
                 .enumerate()
                 .find(|(_, &c)| c >= ORIENTATION_STEPS)
             {
-                return Err(FrameError::OrientationRange {
+                return Err(FeatureError::OrientationRange {
                     octave,
                     index,
                     code,
@@ -203,10 +203,10 @@ impl FeatureFrame {
         height: u32,
         keypoints: Vec<Keypoint>,
         gradients: Gradients,
-    ) -> Result<Self, FrameError> {
+    ) -> Result<Self, FeatureError> {
         if let Gradients::Patches(p) = &gradients {
             if p.len() != keypoints.len() {
-                return Err(FrameError::PatchCount {
+                return Err(FeatureError::PatchCount {
                     patches: p.len(),
                     keypoints: keypoints.len(),
                 });
@@ -220,7 +220,7 @@ impl FeatureFrame {
                 && k.x <= width as f32 - 0.5
                 && k.y <= height as f32 - 0.5;
             if !inside {
-                return Err(FrameError::KeypointPosition {
+                return Err(FeatureError::KeypointPosition {
                     index: i,
                     x: k.x,
                     y: k.y,
@@ -351,11 +351,11 @@ mod tests {
     fn plane_sizes_and_codes_are_checked() {
         assert!(matches!(
             SobelPlane::new(0, 4, 4, vec![0; 15], vec![0; 16]),
-            Err(FrameError::PlaneSize { .. })
+            Err(FeatureError::PlaneSize { .. })
         ));
         assert!(matches!(
             SobelPlane::new(1, 2, 2, vec![0; 4], vec![0, 1, 64, 3]),
-            Err(FrameError::OrientationRange {
+            Err(FeatureError::OrientationRange {
                 index: 2,
                 code: 64,
                 ..
@@ -381,7 +381,7 @@ mod tests {
             vec![kp(1.0, 1.0, 0)],
             Gradients::Patches(vec![]),
         );
-        assert!(matches!(err, Err(FrameError::PatchCount { .. })));
+        assert!(matches!(err, Err(FeatureError::PatchCount { .. })));
         let err = FeatureFrame::new(
             0,
             0,
@@ -392,7 +392,7 @@ mod tests {
         );
         assert!(matches!(
             err,
-            Err(FrameError::KeypointPosition { index: 0, .. })
+            Err(FeatureError::KeypointPosition { index: 0, .. })
         ));
         let f = FeatureFrame::new(
             0,

@@ -97,6 +97,17 @@ pub struct SizeLimits {
     pub min_side: usize,
 }
 
+impl SizeLimits {
+    /// The limits of the fabric's registers (`regmap.toml`): what a session can be
+    /// configured for.
+    pub fn fabric() -> Self {
+        Self {
+            max_width: stereocal_hdl::regs::MAX_WIDTH as usize,
+            min_side: stereocal_hdl::regs::MIN_SIDE as usize,
+        }
+    }
+}
+
 /// The file names of a stereo sequence, checked and paired.
 #[derive(Debug, Clone)]
 pub struct StereoSequence {

@@ -17,7 +17,7 @@ use crate::calib::Calibration;
 use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome};
 use crate::estimator::{EstimatorConfig, FrameEstimate, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
-use crate::link::{Device, InProcessLink, LinkError, Threaded};
+use crate::link::{FrameInput, InProcessLink, Link, LinkError, Threaded};
 use crate::misalignment::{MisalignmentWindow, WindowConfig};
 use crate::output::record::{FrameRecord, FrameStatus};
 use crate::output::summary::RunCost;
@@ -45,13 +45,14 @@ impl Default for SessionConfig {
     }
 }
 
-/// The fabric's configuration for `width` x `height` frames.
+/// The fabric configuration a session writes for `width` x `height` frames: the register
+/// defaults with the host's contrast threshold (the type, `FabricConfig`, is the map's).
 ///
 /// The contrast threshold is 1 grey level (256 in the register's Q8.8) rather than the
 /// register's reset value (8 grey levels, Lowe's 0.03 of full scale): the verge estimate gains
 /// from every stable keypoint, and the ratio test and RANSAC reject the weak ones that do not
 /// match.
-pub fn fabric_config(width: u16, height: u16, sobel_output: SobelOutput) -> FabricConfig {
+pub fn tuned_fabric_config(width: u16, height: u16, sobel_output: SobelOutput) -> FabricConfig {
     FabricConfig {
         width,
         height,
@@ -154,15 +155,18 @@ struct InFlight {
     encoder_verge_deg: Option<f64>,
 }
 
-/// One stereo head, from pixels to filtered verge angle, on device `D`.
+/// One stereo head, from pixels to filtered verge angle, over link `L`.
 ///
-/// Pairs go in with [`Session::submit`] and records come out in the same order. A device with
-/// a [`lookahead`](Device::lookahead) works on the next pairs while the host decodes and
+/// Where the host provides the pixels (`L` has a [`FrameInput`]), pairs go in with
+/// [`Session::submit`] and records come out in the same order. A device with a
+/// [`lookahead`](FrameInput::lookahead) works on the next pairs while the host decodes and
 /// estimates the oldest, so `submit` returns a record only once more pairs are in flight than
 /// the device takes ahead, and [`Session::flush`] collects the rest; [`Session::process`] is
-/// one pair in, its record out.
-pub struct Session<D: Device = Threaded> {
-    driver: Driver<D>,
+/// one pair in, its record out. A head with its own cameras sends pairs when it takes them:
+/// [`Session::receive`] reads the next. Both match the device's frame ids by one rule: late
+/// reports of older frames are skipped, and a newer id means the expected frame was lost.
+pub struct Session<L: Link = Threaded> {
+    driver: Driver<L>,
     fabric: FabricConfig,
     estimator: VergeEstimator,
     filter: VergeFilter,
@@ -172,7 +176,8 @@ pub struct Session<D: Device = Threaded> {
     next_frame_id: u32,
     in_flight: VecDeque<InFlight>,
     /// A pair that came from a device with its own cameras before its session frame did
-    /// (the device skipped ids): it waits for [`Session::receive`] to reach it.
+    /// (the device skipped ids): it waits for [`Session::receive`] to reach it. A session
+    /// whose host provides the pixels never holds one: a skipped id stops it.
     early: Option<PairOutcome>,
     /// Capture time of the last pair filtered.
     last_timestamp_us: Option<u64>,
@@ -196,11 +201,11 @@ impl Session {
     }
 }
 
-impl<D: Device> Session<D> {
+impl<L: Link> Session<L> {
     /// [`Session::new`] on `device`: says Hello, configures the fabric for `width` x
     /// `height`, reads the registers back and enables the device.
     pub fn with_device(
-        device: D,
+        device: L,
         calib: Calibration,
         width: u16,
         height: u16,
@@ -209,7 +214,7 @@ impl<D: Device> Session<D> {
         let timeout = device.answer_timeout();
         let mut driver = Driver::new(device);
         driver.hello(timeout)?;
-        let fabric = fabric_config(width, height, config.sobel_output);
+        let fabric = tuned_fabric_config(width, height, config.sobel_output);
         driver.configure(&fabric, timeout)?;
         driver.enable()?;
         Ok(Self {
@@ -235,7 +240,7 @@ impl<D: Device> Session<D> {
     }
 
     /// The device, e.g. to switch a fault injector or read an emulator's state.
-    pub fn device_mut(&mut self) -> &mut D {
+    pub fn device_mut(&mut self) -> &mut L {
         self.driver.link_mut()
     }
 
@@ -251,101 +256,6 @@ impl<D: Device> Session<D> {
         self.cost
     }
 
-    /// Processes frame pair `frame` captured at `timestamp_us` and returns the oldest record
-    /// in flight: this pair's own when it is the only one (the caller did not
-    /// [`submit`](Session::submit) ahead). `images` is `None` for a pair the grabber lost: the
-    /// filter predicts across it and the record says `dropped`. A pair damaged on the link is
-    /// dropped the same way, never estimated.
-    pub fn process(
-        &mut self,
-        frame: usize,
-        images: Option<(&[u8], &[u8])>,
-        image_size: (usize, usize),
-        timestamp_us: u64,
-        truth_deg: Option<f64>,
-    ) -> Result<FrameRecord, SessionError> {
-        let pair = self.start(frame, images, image_size, timestamp_us, truth_deg)?;
-        self.in_flight.push_back(pair);
-        let oldest = self.in_flight.pop_front().unwrap_or(pair);
-        self.finish(oldest)
-    }
-
-    /// Hands pair `frame` to the device (see [`Session::process`] for the arguments) and
-    /// returns the oldest record once more pairs are in flight than the device works ahead.
-    pub fn submit(
-        &mut self,
-        frame: usize,
-        images: Option<(&[u8], &[u8])>,
-        image_size: (usize, usize),
-        timestamp_us: u64,
-        truth_deg: Option<f64>,
-    ) -> Result<Option<FrameRecord>, SessionError> {
-        let pair = self.start(frame, images, image_size, timestamp_us, truth_deg)?;
-        self.in_flight.push_back(pair);
-        if self.in_flight.len() > self.driver.link().lookahead() {
-            self.flush()
-        } else {
-            Ok(None)
-        }
-    }
-
-    /// The record of the oldest pair in flight; `None` when there is none.
-    pub fn flush(&mut self) -> Result<Option<FrameRecord>, SessionError> {
-        match self.in_flight.pop_front() {
-            Some(pair) => self.finish(pair).map(Some),
-            None => Ok(None),
-        }
-    }
-
-    /// Hands the images, if any, to the device.
-    fn start(
-        &mut self,
-        frame: usize,
-        images: Option<(&[u8], &[u8])>,
-        image_size: (usize, usize),
-        timestamp_us: u64,
-        truth_deg: Option<f64>,
-    ) -> Result<InFlight, SessionError> {
-        let start = Instant::now();
-        if let Some((left, right)) = images {
-            self.check_size(frame, image_size)?;
-            self.driver
-                .link_mut()
-                .submit_pair(left, right, timestamp_us)?;
-        }
-        self.cost.elapsed += start.elapsed();
-        Ok(InFlight {
-            frame,
-            submitted: images.is_some(),
-            timestamp_us,
-            truth_deg,
-            encoder_verge_deg: self.next_encoder_deg.take(),
-        })
-    }
-
-    /// Reads the pair back, estimates and filters it.
-    fn finish(&mut self, pair: InFlight) -> Result<FrameRecord, SessionError> {
-        let start = Instant::now();
-        let (outcome, missing) = if pair.submitted {
-            (
-                self.receive_pair(pair.frame)?,
-                "no complete pair arrived before the answer timeout",
-            )
-        } else {
-            (None, "the grabber lost the pair")
-        };
-        let record = self.conclude(
-            pair.frame,
-            outcome,
-            missing,
-            pair.timestamp_us,
-            pair.encoder_verge_deg,
-            pair.truth_deg,
-        )?;
-        self.cost.elapsed += start.elapsed();
-        Ok(record)
-    }
-
     /// The record of the next pair from a device that captures with its own cameras
     /// ([`OwnCameras`](crate::link::OwnCameras)): session frame `frame`, the device's next
     /// frame id. The filter runs on the capture time the device stamped; a pair that arrived
@@ -358,27 +268,14 @@ impl<D: Device> Session<D> {
     /// 0, is where the session's numbering starts. A head that sends an `Encoders` reading
     /// for the capture gives the filter its verge change as control input.
     pub fn receive(&mut self, frame: usize) -> Result<FrameRecord, SessionError> {
-        let timeout = self.driver.link().answer_timeout();
         let mut expected = self.next_frame_id;
-        let outcome = loop {
-            let outcome = match self.early.take() {
-                Some(outcome) => outcome,
-                None => self.driver.next_pair(timeout)?,
-            };
-            let got = outcome.frame_id();
-            if self.cost.pairs == 0 {
-                // No record yet: the device's numbering is adopted.
-                expected = got;
-            }
-            // Ids wrap: "older" is within half the id space behind. An older pair is the rest
-            // of one already recorded as dropped; a newer one waits for its own frame.
-            if got == expected {
-                self.cost.wire_bytes += outcome.wire_bytes();
-                break Some(outcome);
-            }
-            if expected.wrapping_sub(got) > u32::MAX / 2 {
+        // No record yet: the device's numbering is adopted.
+        let outcome = match self.next_arrival(&mut expected, self.cost.pairs == 0)? {
+            Arrival::Expected(outcome) => Some(outcome),
+            // A newer pair waits for its own frame.
+            Arrival::Ahead(outcome) => {
                 self.early = Some(outcome);
-                break None;
+                None
             }
         };
         self.next_frame_id = expected.wrapping_add(1);
@@ -404,6 +301,37 @@ impl<D: Device> Session<D> {
         )?;
         self.cost.elapsed += start.elapsed();
         Ok(record)
+    }
+
+    /// The next pair the driver delivers for device frame id `expected`, or the first with a
+    /// newer id. With `adopt`, the first pair's id becomes `expected` (a head that streamed
+    /// before this host connected).
+    ///
+    /// Ids wrap: "older" is within half the id space behind. A link that loses bytes can lose
+    /// a frame's end: the driver then times out on the pair, and reports the frame as damaged
+    /// only later, when the next frame's packets show the old one will never finish. Such
+    /// late reports carry an older id than the one expected and are skipped (that frame was
+    /// already recorded as dropped), so a fault costs the frames it hit and never shifts a
+    /// later estimate onto the wrong frame.
+    fn next_arrival(&mut self, expected: &mut u32, adopt: bool) -> Result<Arrival, DriverError> {
+        let timeout = self.driver.link().answer_timeout();
+        loop {
+            let outcome = match self.early.take() {
+                Some(outcome) => outcome,
+                None => self.driver.next_pair(timeout)?,
+            };
+            let got = outcome.frame_id();
+            if adopt {
+                *expected = got;
+            }
+            if got == *expected {
+                self.cost.wire_bytes += outcome.wire_bytes();
+                return Ok(Arrival::Expected(outcome));
+            }
+            if expected.wrapping_sub(got) > u32::MAX / 2 {
+                return Ok(Arrival::Ahead(outcome));
+            }
+        }
     }
 
     /// Estimates and filters one pair's outcome into its record; `missing` says why there is
@@ -531,40 +459,127 @@ impl<D: Device> Session<D> {
             })
         }
     }
+}
 
-    /// The outcome of the pair just submitted; `None` when it never arrived complete.
-    ///
-    /// A link that loses bytes can lose a frame's end: the driver then times out on the pair,
-    /// and reports the frame as damaged only later, when the next frame's packets show the old
-    /// one will never finish. Such late reports carry an older frame id than the pair
-    /// submitted and are skipped (that frame was already recorded as dropped), so a fault
-    /// costs the frames it hit and never shifts a later estimate onto the wrong frame. A pair
-    /// with a newer id than any submitted means host and device disagree about which images
-    /// they are: that stops the session.
+/// A pair the driver delivered, against the device frame id the session expects.
+enum Arrival {
+    Expected(PairOutcome),
+    /// A newer id: the expected frame never came whole.
+    Ahead(PairOutcome),
+}
+
+impl<L: Link + FrameInput> Session<L> {
+    /// Processes frame pair `frame` captured at `timestamp_us` and returns the oldest record
+    /// in flight: this pair's own when it is the only one (the caller did not
+    /// [`submit`](Session::submit) ahead). `images` is `None` for a pair the grabber lost: the
+    /// filter predicts across it and the record says `dropped`. A pair damaged on the link is
+    /// dropped the same way, never estimated.
+    pub fn process(
+        &mut self,
+        frame: usize,
+        images: Option<(&[u8], &[u8])>,
+        image_size: (usize, usize),
+        timestamp_us: u64,
+        truth_deg: Option<f64>,
+    ) -> Result<FrameRecord, SessionError> {
+        let pair = self.start(frame, images, image_size, timestamp_us, truth_deg)?;
+        self.in_flight.push_back(pair);
+        let oldest = self.in_flight.pop_front().unwrap_or(pair);
+        self.finish(oldest)
+    }
+
+    /// Hands pair `frame` to the device (see [`Session::process`] for the arguments) and
+    /// returns the oldest record once more pairs are in flight than the device works ahead.
+    pub fn submit(
+        &mut self,
+        frame: usize,
+        images: Option<(&[u8], &[u8])>,
+        image_size: (usize, usize),
+        timestamp_us: u64,
+        truth_deg: Option<f64>,
+    ) -> Result<Option<FrameRecord>, SessionError> {
+        let pair = self.start(frame, images, image_size, timestamp_us, truth_deg)?;
+        self.in_flight.push_back(pair);
+        if self.in_flight.len() > self.driver.link().lookahead() {
+            self.flush()
+        } else {
+            Ok(None)
+        }
+    }
+
+    /// The record of the oldest pair in flight; `None` when there is none.
+    pub fn flush(&mut self) -> Result<Option<FrameRecord>, SessionError> {
+        match self.in_flight.pop_front() {
+            Some(pair) => self.finish(pair).map(Some),
+            None => Ok(None),
+        }
+    }
+
+    /// Hands the images, if any, to the device.
+    fn start(
+        &mut self,
+        frame: usize,
+        images: Option<(&[u8], &[u8])>,
+        image_size: (usize, usize),
+        timestamp_us: u64,
+        truth_deg: Option<f64>,
+    ) -> Result<InFlight, SessionError> {
+        let start = Instant::now();
+        if let Some((left, right)) = images {
+            self.check_size(frame, image_size)?;
+            self.driver
+                .link_mut()
+                .submit_pair(left, right, timestamp_us)?;
+        }
+        self.cost.elapsed += start.elapsed();
+        Ok(InFlight {
+            frame,
+            submitted: images.is_some(),
+            timestamp_us,
+            truth_deg,
+            encoder_verge_deg: self.next_encoder_deg.take(),
+        })
+    }
+
+    /// Reads the pair back, estimates and filters it.
+    fn finish(&mut self, pair: InFlight) -> Result<FrameRecord, SessionError> {
+        let start = Instant::now();
+        let (outcome, missing) = if pair.submitted {
+            (
+                self.receive_pair(pair.frame)?,
+                "no complete pair arrived before the answer timeout",
+            )
+        } else {
+            (None, "the grabber lost the pair")
+        };
+        let record = self.conclude(
+            pair.frame,
+            outcome,
+            missing,
+            pair.timestamp_us,
+            pair.encoder_verge_deg,
+            pair.truth_deg,
+        )?;
+        self.cost.elapsed += start.elapsed();
+        Ok(record)
+    }
+
+    /// The outcome of the pair just submitted; `None` when it never arrived complete (see
+    /// [`Session::next_arrival`] for late reports of older frames). A pair with a newer id
+    /// than any submitted means host and device disagree about which images they are: that
+    /// stops the session.
     fn receive_pair(&mut self, frame: usize) -> Result<Option<PairOutcome>, SessionError> {
-        let expected = self.next_frame_id;
+        let mut expected = self.next_frame_id;
         self.next_frame_id = expected.wrapping_add(1);
-        let timeout = self.driver.link().answer_timeout();
-        loop {
-            let outcome = match self.driver.next_pair(timeout) {
-                Ok(outcome) => outcome,
-                Err(DriverError::Timeout { .. }) => return Ok(None),
-                Err(e) => return Err(e.into()),
-            };
-            self.cost.wire_bytes += outcome.wire_bytes();
-            let got = outcome.frame_id();
-            // Ids wrap: "older" is within half the id space behind.
-            let behind = expected.wrapping_sub(got);
-            if got == expected {
-                return Ok(Some(outcome));
-            }
-            if behind > u32::MAX / 2 {
-                return Err(SessionError::OutOfStep {
-                    frame,
-                    got,
-                    expected,
-                });
-            }
+        match self.next_arrival(&mut expected, false) {
+            Ok(Arrival::Expected(outcome)) => Ok(Some(outcome)),
+            Ok(Arrival::Ahead(outcome)) => Err(SessionError::OutOfStep {
+                frame,
+                got: outcome.frame_id(),
+                expected,
+            }),
+            Err(DriverError::Timeout { .. }) => Ok(None),
+            Err(e) => Err(e.into()),
         }
     }
 }

@@ -5,7 +5,7 @@
 use std::time::{Duration, Instant};
 
 use stereocal::driver::{Driver, FrameOutcome, PairOutcome};
-use stereocal::link::{Device, InProcessLink, Link, LinkError, Threaded};
+use stereocal::link::{FrameInput, InProcessLink, Link, LinkError, Threaded};
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hdl::FabricConfig;
 
@@ -51,7 +51,7 @@ fn drain(link: &mut impl Link) -> Vec<u8> {
 
 /// The bytes of configuring `device` and running three pairs through it, all submitted before
 /// the first byte is read.
-fn three_pairs(mut device: impl Device) -> Vec<u8> {
+fn three_pairs(mut device: impl Link + FrameInput) -> Vec<u8> {
     Driver::new(&mut device).configure(&config(), T).unwrap();
     let mut bytes = drain(&mut device);
     for frame in 0..3u32 {

@@ -27,7 +27,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use stereocal::calib::Calibration;
-use stereocal::link::{Device, InProcessLink, Recording};
+use stereocal::link::{FrameInput, InProcessLink, Link, Recording};
 use stereocal::output::record::FrameRecord;
 use stereocal::session::{Session, SessionConfig, SessionError};
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
@@ -105,7 +105,10 @@ impl Scenario {
     }
 
     /// Runs the pairs on `device` through a host session; the records, one per pair.
-    pub fn run_session<D: Device>(&self, device: D) -> Result<Vec<FrameRecord>, SessionError> {
+    pub fn run_session<D: Link + FrameInput>(
+        &self,
+        device: D,
+    ) -> Result<Vec<FrameRecord>, SessionError> {
         let mut session =
             Session::with_device(device, self.calib, self.width, self.height, self.config)?;
         let size = (usize::from(self.width), usize::from(self.height));

@@ -11,7 +11,7 @@ use std::time::Duration;
 use stereocal::driver::Driver;
 use stereocal::output::record::FrameStatus;
 use stereocal::output::summary::{Residual, RunCost, Summary};
-use stereocal::session::{fabric_config, SessionConfig, SessionError};
+use stereocal::session::{tuned_fabric_config, SessionConfig, SessionError};
 use stereocal_firmware::softcore::finisher::ExitCode;
 use stereocal_firmware::softcore::stack::StackReport;
 use stereocal_hdl::regs::output_mode::SobelOutput;
@@ -216,7 +216,7 @@ fn qemu_firmware_failure_reports_exit_code_and_log() {
         let t = Duration::from_secs(30);
         driver.hello(t).map_err(driver_error)?;
         driver
-            .configure(&fabric_config(160, 120, SobelOutput::Rows), t)
+            .configure(&tuned_fabric_config(160, 120, SobelOutput::Rows), t)
             .map_err(driver_error)?;
         driver.enable().map_err(driver_error)?;
         driver.next_pair(t).map_err(driver_error)

@@ -9,7 +9,6 @@ use clap::{ArgGroup, Args, ValueEnum};
 use image::GrayImage;
 use stereocal::calib::Calibration;
 use stereocal::image_sequence::{load_gray, SizeLimits, StereoSequence};
-use stereocal_hdl::regs::{MAX_WIDTH, MIN_SIDE};
 use stereocal_synth::injected::{write_injected, Motion, Source};
 
 use crate::output::progress_bar;
@@ -92,10 +91,7 @@ pub fn inject(args: &InjectArgs) -> anyhow::Result<()> {
         (_, _, Some(l), Some(r)) => {
             // The fabric's limits, checked here so that a sequence `run` cannot take fails
             // before anything is written.
-            let limits = SizeLimits {
-                max_width: MAX_WIDTH as usize,
-                min_side: MIN_SIDE as usize,
-            };
+            let limits = SizeLimits::fabric();
             Input::Sequence(StereoSequence::open(l, r, limits)?)
         }
         _ => anyhow::bail!("give --left-image and --right-image, or --left and --right"),

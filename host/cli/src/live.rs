@@ -83,7 +83,7 @@ pub fn live(args: &LiveArgs) -> anyhow::Result<()> {
         open_unix(path)?
     };
     let timeout = Duration::from_millis(args.timeout_ms);
-    let device = OwnCameras::new(link, name.clone(), timeout);
+    let device = OwnCameras::new(link, timeout);
     let mut session = Session::with_device(
         device,
         calib,

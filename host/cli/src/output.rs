@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use stereocal::output::record::FrameRecord;
 use stereocal::output::report::{summary_table, write_outputs, TableExtras};
 use stereocal::output::summary::Summary;
-use stereocal::session::fabric_config;
+use stereocal::session::tuned_fabric_config;
 use stereocal_firmware::fabric::latency::first_pixel_of_last_octave;
 use stereocal_hdl::regs::output_mode::SobelOutput;
 
@@ -58,7 +58,7 @@ pub fn finish(
         println!("{}", serde_json::to_string_pretty(summary)?);
     } else {
         // The latency does not depend on the Sobel output mode.
-        let fabric = fabric_config(width as u16, height as u16, SobelOutput::Rows);
+        let fabric = tuned_fabric_config(width as u16, height as u16, SobelOutput::Rows);
         let latency = first_pixel_of_last_octave(fabric.width, fabric.height, fabric.octaves);
         let extras = TableExtras {
             rows: vec![

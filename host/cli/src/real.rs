@@ -11,8 +11,8 @@ use stereocal::image_sequence::{GrayFrame, SizeLimits, StereoSequence};
 use stereocal::output::record::FrameRecord;
 use stereocal::output::summary::{Residual, Summary};
 use stereocal::output::verge_csv::read_truth_csv;
-use stereocal::session::{fabric_config, Session};
-use stereocal_hdl::regs::{MAX_HEIGHT, MAX_WIDTH, MIN_SIDE};
+use stereocal::session::{tuned_fabric_config, Session};
+use stereocal_hdl::regs::MAX_HEIGHT;
 
 use crate::options::EstimateArgs;
 use crate::output::{finish, keep, progress_bar, Finish};
@@ -59,10 +59,7 @@ pub struct RunArgs {
 pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     // Everything that can be checked before the first frame is, so a bad call writes nothing.
     let calib = Calibration::load(&args.calib)?;
-    let limits = SizeLimits {
-        max_width: MAX_WIDTH as usize,
-        min_side: MIN_SIDE as usize,
-    };
+    let limits = SizeLimits::fabric();
     let sequence = StereoSequence::open(&args.left, &args.right, limits)?;
     let truth = match &args.truth {
         Some(path) => {
@@ -94,7 +91,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     // 2^(octaves-1) on each side; like a grabber's region of interest it starts at the
     // top-left corner, which keeps the intrinsics valid.
     let config = args.estimate.session_config();
-    let step = 1usize << (fabric_config(16, 16, config.sobel_output).octaves - 1);
+    let step = 1usize << (tuned_fabric_config(16, 16, config.sobel_output).octaves - 1);
     let window = (size.0 / step * step, size.1 / step * step);
     if window != size {
         eprintln!(

@@ -12,7 +12,7 @@ use std::process::{Command, Output};
 use std::thread;
 use std::time::Duration;
 
-use stereocal::link::{Device, InProcessLink, Link, TimedStream};
+use stereocal::link::{InProcessLink, Link, TimedStream};
 
 const BIN: &str = env!("CARGO_BIN_EXE_stereocal");
 const FRAMES: usize = 4;
@@ -129,7 +129,7 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
     let mut device = InProcessLink::new().unwrap();
     for _ in 0..q.before {
         device.submit_pair(&left[0], &right[0], 0).unwrap();
-        Device::take_sent(&mut device, &mut Vec::new()).unwrap();
+        Link::take_sent(&mut device, &mut Vec::new()).unwrap();
     }
     stream
         .set_receive_timeout(Duration::from_millis(10))
@@ -147,7 +147,7 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
         }
         let mut send = |device: &mut InProcessLink, damage: bool, pair: Option<usize>| {
             out.clear();
-            Device::take_sent(device, &mut out).unwrap();
+            Link::take_sent(device, &mut out).unwrap();
             if q.encoders {
                 out = resequence(&out, &mut seq, pair);
             }

@@ -171,7 +171,7 @@ fuzz_target!(|data: &[u8]| {
         0..=127 => ReplayLink::new(stream),
         _ => ReplayLink::new(stream).with_chunk(usize::from(chunk - 127) * 2),
     };
-    let device = OwnCameras::new(link, "fuzz replay", Duration::from_millis(1));
+    let device = OwnCameras::new(link, Duration::from_millis(1));
     let mut session = Session::with_device(device, reference.calib, W, H, SessionConfig::default())
         .expect("the recorded handshake replays");
     let mut raw_verge_deg = Vec::new();

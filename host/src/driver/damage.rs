@@ -4,7 +4,7 @@ use std::fmt;
 
 use stereocal_wire::{Camera, PacketKind};
 
-use crate::features::FrameError;
+use crate::features::FeatureError;
 
 /// A packet, identified the way a log line needs it: kind, sequence number, frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -109,7 +109,7 @@ pub enum Damage {
         /// Camera.
         camera: Camera,
         /// The check that failed.
-        error: FrameError,
+        error: FeatureError,
     },
 }
 

@@ -11,7 +11,7 @@ use stereocal_wire::{
 };
 
 use super::damage::ContentError;
-use crate::features::{FrameError, Gradients, Keypoint, SobelPatch, SobelPlane};
+use crate::features::{FeatureError, Gradients, Keypoint, SobelPatch, SobelPlane};
 
 /// Pixels [`split_pixels`] handles per step: a multiple of the SIMD width, and long enough
 /// that the per-step slicing is small next to the copying.
@@ -321,7 +321,7 @@ impl GradientBuilder {
 /// Why the gradients could not be finished.
 pub(crate) enum FinishError {
     Content(ContentError),
-    Frame(FrameError),
+    Frame(FeatureError),
 }
 
 #[cfg(test)]
@@ -386,7 +386,7 @@ mod tests {
         }
         assert!(matches!(
             builder.finish(&[], Vec::new()),
-            Err(FinishError::Frame(FrameError::OrientationRange {
+            Err(FinishError::Frame(FeatureError::OrientationRange {
                 octave: 0,
                 index: 75,
                 code: 64

@@ -40,12 +40,6 @@ pub enum LinkError {
         #[source]
         source: io::Error,
     },
-    /// Pixels were handed to a device that captures with its own cameras.
-    #[error("{link}: the device captures with its own cameras and takes no frames from the host")]
-    OwnCameras {
-        /// The link.
-        link: String,
-    },
     /// The in-process device refused a frame or a packet.
     #[error("in-process device: {0}")]
     Device(String),

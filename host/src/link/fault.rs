@@ -2,7 +2,7 @@
 //! noisy UART (bit flips, lost bytes) and a misbehaving bridge between it and the host
 //! (truncated, duplicated, reordered packets, stalls) would do to them.
 //!
-//! [`FaultLink`] wraps any [`Link`] (and is a [`Device`] when the wrapped link is one), so the
+//! [`FaultLink`] wraps any [`Link`] (and passes a [`FrameInput`] through when the wrapped link has one), so the
 //! driver above it runs unchanged: every fault reaches the host exactly where a real one
 //! would, in the byte stream, and the wire format's COBS framing, CRC-32C and sequence
 //! numbers are what has to catch it. Only the device-to-host direction is damaged: requests
@@ -20,7 +20,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use stereocal_wire::DELIMITER;
 
-use super::{Device, Link, LinkError};
+use super::{FrameInput, Link, LinkError};
 
 /// Bytes asked of the wrapped link per receive.
 const PULL_CHUNK: usize = 64 * 1024;
@@ -318,6 +318,10 @@ impl<L: Link> Link for FaultLink<L> {
         self.inner.send(bytes)
     }
 
+    fn answer_timeout(&self) -> Duration {
+        self.inner.answer_timeout()
+    }
+
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
         loop {
             if let Some(front) = self.outgoing.front_mut() {
@@ -346,7 +350,7 @@ impl<L: Link> Link for FaultLink<L> {
     }
 }
 
-impl<D: Device> Device for FaultLink<D> {
+impl<D: Link + FrameInput> FrameInput for FaultLink<D> {
     fn submit_pair(
         &mut self,
         left: &[u8],
@@ -354,10 +358,6 @@ impl<D: Device> Device for FaultLink<D> {
         timestamp_us: u64,
     ) -> Result<(), LinkError> {
         self.inner.submit_pair(left, right, timestamp_us)
-    }
-
-    fn answer_timeout(&self) -> Duration {
-        self.inner.answer_timeout()
     }
 }
 

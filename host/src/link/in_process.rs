@@ -211,12 +211,6 @@ impl InProcessLink {
         Ok([left_summary, right_summary])
     }
 
-    /// Moves every byte the device sent and the host has not read into `out` (see
-    /// [`Device::take_sent`](super::Device::take_sent)).
-    pub fn take_sent(&mut self, out: &mut Vec<u8>) {
-        self.writer.sink_mut().take_into(out);
-    }
-
     /// Whether the host has set CONTROL.ENABLE: a head with its own cameras (the firmware's
     /// main loop, a board) starts grabbing then, so a stand-in for one waits for it.
     pub fn enabled(&mut self) -> bool {
@@ -283,6 +277,12 @@ impl Link for InProcessLink {
             result?;
             window = rest;
         }
+        Ok(())
+    }
+
+    /// Moves every byte the device sent and the host has not read into `out` at once.
+    fn take_sent(&mut self, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        self.writer.sink_mut().take_into(out);
         Ok(())
     }
 

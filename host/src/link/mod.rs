@@ -15,14 +15,15 @@
 //! | Unix socket (QEMU `-chardev socket,path=..`) | [`UnixLink`] | [`StreamLink::unix`] |
 //! | a byte capture played back | [`ReplayLink`] | [`ReplayLink::new`], [`ReplayLink::from_file`] |
 //! | any link above, its received bytes damaged by seed | [`FaultLink`] | [`FaultLink::new`] |
-//! | the firmware ELF under `qemu-system-riscv32` | [`QemuDevice`](stereocal_tools::hil::QemuDevice) | [`QemuDevice::start`](stereocal_tools::hil::QemuDevice::start) |
+//! | the firmware ELF under `qemu-system-riscv32` | `QemuDevice` (`stereocal-tools`) | `QemuDevice::start` |
 //!
-//! A link that also takes camera frames is a [`Device`]: what a session runs on. A head that
-//! grabs its own frames (a board, an emulator started by hand) is one through [`OwnCameras`].
+//! A device whose pixels the host provides also has a [`FrameInput`]; a head that grabs its
+//! own frames (a board, an emulator started by hand) has only its link, named and timed by
+//! [`OwnCameras`].
 
-mod device;
 mod error;
 mod fault;
+mod frame_input;
 mod in_process;
 mod own_cameras;
 mod recording;
@@ -35,11 +36,11 @@ mod threaded;
 #[cfg(unix)]
 mod unix;
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
-pub use device::Device;
 pub use error::LinkError;
 pub use fault::{BadRate, FaultConfig, FaultCounts, FaultLink};
+pub use frame_input::FrameInput;
 pub use in_process::InProcessLink;
 pub use own_cameras::OwnCameras;
 pub use recording::Recording;
@@ -65,7 +66,32 @@ pub trait Link: Send {
     /// Passing the deadline is [`LinkError::Timeout`]; a peer that closed the link is
     /// [`LinkError::Closed`].
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError>;
+
+    /// How long the host waits for one answer or one frame pair over this link.
+    fn answer_timeout(&self) -> Duration {
+        DEFAULT_ANSWER_TIMEOUT
+    }
+
+    /// Appends to `out` every byte the device has sent so far and the host has not read.
+    /// The default reads them through [`Link::recv`] without waiting, so a wrapper that
+    /// records or damages what `recv` returns sees them; a device that holds its output in
+    /// memory hands it over whole.
+    fn take_sent(&mut self, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        let mut chunk = [0u8; 4096];
+        loop {
+            match self.recv(&mut chunk, Instant::now()) {
+                Ok(n) => out.extend_from_slice(chunk.get(..n).unwrap_or_default()),
+                Err(LinkError::Timeout { .. }) => return Ok(()),
+                Err(e) => return Err(e),
+            }
+        }
+    }
 }
+
+/// The answer timeout of a link that does not state its own: a device answers a request
+/// within microseconds and sends a pair's packets within a frame time, so seconds of silence
+/// mean it stopped, whatever its frame rate.
+pub const DEFAULT_ANSWER_TIMEOUT: Duration = Duration::from_secs(5);
 
 impl<L: Link + ?Sized> Link for Box<L> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
@@ -74,6 +100,14 @@ impl<L: Link + ?Sized> Link for Box<L> {
 
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
         (**self).recv(buf, deadline)
+    }
+
+    fn answer_timeout(&self) -> Duration {
+        (**self).answer_timeout()
+    }
+
+    fn take_sent(&mut self, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        (**self).take_sent(out)
     }
 }
 
@@ -84,5 +118,13 @@ impl<L: Link + ?Sized> Link for &mut L {
 
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
         (**self).recv(buf, deadline)
+    }
+
+    fn answer_timeout(&self) -> Duration {
+        (**self).answer_timeout()
+    }
+
+    fn take_sent(&mut self, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        (**self).take_sent(out)
     }
 }

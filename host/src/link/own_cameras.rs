@@ -3,30 +3,25 @@
 //!
 //! The host configures and enables such a device and then only listens: pairs arrive when
 //! the cameras take them, stamped with the device's own capture time. It takes no pixels from
-//! the host, so [`Device::submit_pair`] is an error rather than a silent no-op; sessions on it
-//! read pairs with [`Session::receive`](crate::session::Session::receive).
+//! the host, so it has no [`FrameInput`](super::FrameInput); sessions on it read pairs with
+//! [`Session::receive`](crate::session::Session::receive).
 
 use std::time::{Duration, Instant};
 
-use super::{Device, Link, LinkError};
+use super::{Link, LinkError};
 
-/// A [`Link`] to a stereo head that grabs its own frames.
+/// A [`Link`] to a stereo head that grabs its own frames, with the time the host waits for
+/// its next pair (the head's frame period and then some, which only its user knows).
 #[derive(Debug)]
 pub struct OwnCameras<L> {
     link: L,
-    name: String,
     timeout: Duration,
 }
 
 impl<L: Link> OwnCameras<L> {
-    /// Wraps `link` (named `name` in errors, e.g. `"serial /dev/ttyUSB0"`); the host waits
-    /// at most `timeout` for an answer or for the next pair.
-    pub fn new(link: L, name: impl Into<String>, timeout: Duration) -> Self {
-        Self {
-            link,
-            name: name.into(),
-            timeout,
-        }
+    /// Wraps `link`; the host waits at most `timeout` for an answer or for the next pair.
+    pub fn new(link: L, timeout: Duration) -> Self {
+        Self { link, timeout }
     }
 }
 
@@ -37,14 +32,6 @@ impl<L: Link> Link for OwnCameras<L> {
 
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
         self.link.recv(buf, deadline)
-    }
-}
-
-impl<L: Link> Device for OwnCameras<L> {
-    fn submit_pair(&mut self, _: &[u8], _: &[u8], _: u64) -> Result<(), LinkError> {
-        Err(LinkError::OwnCameras {
-            link: self.name.clone(),
-        })
     }
 
     fn answer_timeout(&self) -> Duration {

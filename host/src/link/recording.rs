@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::{Device, Link, LinkError};
+use super::{FrameInput, Link, LinkError};
 
 /// `inner`, with every byte received from it kept in order.
 #[derive(Debug)]
@@ -46,9 +46,13 @@ impl<L: Link> Link for Recording<L> {
         self.received.extend_from_slice(&buf[..n]);
         Ok(n)
     }
+
+    fn answer_timeout(&self) -> Duration {
+        self.inner.answer_timeout()
+    }
 }
 
-impl<D: Device> Device for Recording<D> {
+impl<D: FrameInput> FrameInput for Recording<D> {
     fn submit_pair(
         &mut self,
         left: &[u8],
@@ -56,10 +60,6 @@ impl<D: Device> Device for Recording<D> {
         timestamp_us: u64,
     ) -> Result<(), LinkError> {
         self.inner.submit_pair(left, right, timestamp_us)
-    }
-
-    fn answer_timeout(&self) -> Duration {
-        self.inner.answer_timeout()
     }
 
     fn lookahead(&self) -> usize {

@@ -5,7 +5,7 @@
 //! does not wait for the host: it works on the next pair while the host works on the last.
 //! [`Threaded`] gives the in-process device that shape. Requests and pairs go to a worker
 //! thread in order; the bytes each one produces collect in a queue that [`Link::recv`] reads,
-//! so a session can submit pair `n + 1` before it reads pair `n` ([`Device::lookahead`]).
+//! so a session can submit pair `n + 1` before it reads pair `n` ([`FrameInput::lookahead`]).
 //!
 //! The wrapped device must only speak when spoken to, as the in-process one does: the worker
 //! collects its bytes after each request or pair, so a byte it sent unasked would wait for
@@ -18,7 +18,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use super::{Device, Link, LinkError};
+use super::{FrameInput, Link, LinkError};
 
 /// Pairs a session may have in the worker beyond the one it is reading.
 const LOOKAHEAD: usize = 1;
@@ -73,7 +73,7 @@ pub struct Threaded {
 
 impl Threaded {
     /// Moves `device` into a new worker thread named `name` (the link's name in errors).
-    pub fn new<D: Device + 'static>(device: D, name: &str) -> Result<Self, LinkError> {
+    pub fn new<D: Link + FrameInput + 'static>(device: D, name: &str) -> Result<Self, LinkError> {
         let timeout = device.answer_timeout();
         let shared = Arc::new(Shared::default());
         let (jobs, inbox) = mpsc::channel::<Job>();
@@ -110,7 +110,7 @@ impl Threaded {
 }
 
 /// The worker: runs each job, then collects what the device sent.
-fn serve<D: Device>(mut device: D, inbox: mpsc::Receiver<Job>, shared: &Shared) {
+fn serve<D: Link + FrameInput>(mut device: D, inbox: mpsc::Receiver<Job>, shared: &Shared) {
     for job in inbox {
         let result = match job {
             Job::Send(bytes) => device.send(&bytes),
@@ -178,9 +178,13 @@ impl Link for Threaded {
                 .0;
         }
     }
+
+    fn answer_timeout(&self) -> Duration {
+        self.timeout
+    }
 }
 
-impl Device for Threaded {
+impl FrameInput for Threaded {
     fn submit_pair(
         &mut self,
         left: &[u8],
@@ -192,10 +196,6 @@ impl Device for Threaded {
             right: right.to_vec(),
             timestamp_us,
         })
-    }
-
-    fn answer_timeout(&self) -> Duration {
-        self.timeout
     }
 
     fn lookahead(&self) -> usize {

@@ -7,7 +7,7 @@
 use std::sync::mpsc;
 
 use stereocal::calib::{CalibError, Calibration};
-use stereocal::link::Device;
+use stereocal::link::{FrameInput, Link};
 use stereocal::output::record::FrameRecord;
 use stereocal::session::{Session, SessionConfig, SessionCost, SessionError};
 use stereocal_synth::{Sequence, StereoFrame, SynthError};
@@ -80,7 +80,7 @@ pub fn fabric_size(sequence: &Sequence) -> Result<(u16, u16), EvalError> {
 /// Runs `frames` of `sequence` (rendered by the caller, in order) through `session`, on
 /// whatever device it has; `progress` is called after each frame. The session keeps its
 /// cost and its device, so the caller can stop the device and tell why a run failed.
-pub fn evaluate_frames<D: Device>(
+pub fn evaluate_frames<D: Link + FrameInput>(
     session: &mut Session<D>,
     sequence: &Sequence,
     frames: impl IntoIterator<Item = Result<StereoFrame, SynthError>>,

@@ -28,9 +28,9 @@ use crate::workload::{Workload, WorkloadError};
 use stereocal::driver::{Driver, DriverError, FrameOutcome, LinkStats, ReceivedFrame};
 use stereocal::estimator::{EstimatorConfig, VergeEstimator};
 use stereocal::link::{
-    BadRate, Device, FaultConfig, FaultCounts, FaultLink, InProcessLink, LinkError,
+    BadRate, FaultConfig, FaultCounts, FaultLink, FrameInput, InProcessLink, Link, LinkError,
 };
-use stereocal::session::fabric_config;
+use stereocal::session::tuned_fabric_config;
 
 /// Why a reliability run failed (a fault never is a reason: those cost frames).
 #[derive(Debug, thiserror::Error)]
@@ -80,7 +80,7 @@ pub fn run(
     let mut driver = Driver::new(link);
     driver.hello(timeout)?;
     driver.configure(
-        &fabric_config(workload.width, workload.height, SobelOutput::Rows),
+        &tuned_fabric_config(workload.width, workload.height, SobelOutput::Rows),
         timeout,
     )?;
     driver.enable()?;
@@ -110,7 +110,7 @@ pub fn run(
 /// Takes every frame the driver can assemble from the bytes the device has sent, and pairs
 /// the delivered ones by frame id. The in-process device answers synchronously, so its
 /// receive times out at once when a pair's bytes are used up.
-fn drain_pairs<D: Device>(
+fn drain_pairs<D: Link + FrameInput>(
     driver: &mut Driver<FaultLink<D>>,
     timeout: Duration,
 ) -> Result<Vec<(u32, ReceivedFrame, ReceivedFrame)>, ReliabilityError> {

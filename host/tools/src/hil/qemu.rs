@@ -1,5 +1,5 @@
 //! The firmware ELF on an emulated soft-core: `qemu-system-riscv32 -machine virt` as a
-//! [`Device`].
+//! [`Link`] with a [`FrameInput`].
 //!
 //! [`QemuDevice::start`] writes the pairs into a frame-grabber file, starts QEMU with that
 //! file loaded at the soft-core's frame region and the UART on a Unix socket, and connects to
@@ -33,7 +33,7 @@ use stereocal_firmware::softcore::frame_input::VIRT_FRAME_REGION;
 
 use super::input::PairDigest;
 use super::{FirmwareExit, GrabberInput, HilError, TimeoutKind};
-use stereocal::link::{Device, Link, LinkError, Recording, StreamLink, UnixLink};
+use stereocal::link::{FrameInput, Link, LinkError, Recording, StreamLink, UnixLink};
 
 /// The emulator, found on `PATH` unless [`QemuConfig::qemu`] says otherwise.
 pub const DEFAULT_QEMU: &str = "qemu-system-riscv32";
@@ -345,9 +345,13 @@ impl Link for QemuDevice {
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
         self.link.recv(buf, deadline)
     }
+
+    fn answer_timeout(&self) -> Duration {
+        self.timeouts.answer
+    }
 }
 
-impl Device for QemuDevice {
+impl FrameInput for QemuDevice {
     /// The pairs were loaded at boot; this only checks that the host asks for the pair the
     /// firmware will run next, so host records and device frames cannot drift apart.
     fn submit_pair(
@@ -373,10 +377,6 @@ impl Device for QemuDevice {
         }
         self.submitted += 1;
         Ok(())
-    }
-
-    fn answer_timeout(&self) -> Duration {
-        self.timeouts.answer
     }
 }
 
