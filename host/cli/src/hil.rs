@@ -12,7 +12,7 @@ use stereocal_tools::hil::{
     instruction_reports, kernel_report, run_sequence, QemuConfig, QemuTimeouts, DEFAULT_QEMU,
 };
 
-use crate::options::EstimateArgs;
+use crate::options::{EstimateArgs, SizeArgs};
 use crate::output::{finish, progress_bar, Finish};
 
 #[derive(Debug, Clone, Args)]
@@ -34,6 +34,8 @@ pub struct HilArgs {
     #[arg(long)]
     trajectory: Option<TrajectoryKind>,
     #[command(flatten)]
+    size: SizeArgs,
+    #[command(flatten)]
     estimate: EstimateArgs,
     /// The QEMU binary.
     #[arg(long, default_value = DEFAULT_QEMU)]
@@ -42,7 +44,8 @@ pub struct HilArgs {
     #[arg(long, default_value_t = QemuTimeouts::default().answer.as_secs(),
           value_parser = clap::value_parser!(u64).range(1..=86_400))]
     timeout: u64,
-    /// Run with `-icount shift=0` and print the soft-core's instructions per pixel.
+    /// Run with `-icount shift=0` and print the soft-core's instructions per pixel, and per
+    /// pair its program's own (`softcore_instructions_per_pair` in `--json`).
     #[arg(long)]
     count_instructions: bool,
     /// Print the firmware's log messages (decoded with the ELF's defmt table) on stderr.
@@ -63,6 +66,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
     if let Some(t) = args.trajectory {
         config.trajectory = t;
     }
+    args.size.apply(&mut config);
     let sequence = Sequence::builtin(args.scene, config)
         .with_context(|| format!("cannot build the `{}` sequence", args.scene))?;
     let qemu = QemuConfig {
@@ -92,8 +96,13 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
             eprintln!("firmware {log}");
         }
     }
+    let mut json_extra = serde_json::Map::new();
     if args.count_instructions {
         print_instructions(&run.logs);
+        let per_pair = softcore_instructions_per_pair(&run.logs)
+            .context("the firmware sent no instruction reports")?;
+        eprintln!("soft-core program, most instructions in one pair: {per_pair}");
+        json_extra.insert("softcore_instructions_per_pair".into(), per_pair.into());
     }
     eprintln!(
         "QEMU: {}, {} bytes from the UART",
@@ -119,6 +128,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
             out: args.out.as_deref(),
             json: args.json,
             title: &title,
+            json_extra,
         },
     )
 }
@@ -156,5 +166,53 @@ fn print_instructions(logs: &[stereocal_tools::hil::DeviceLog]) {
             k.per_pixel(k.dog),
             k.per_pixel(k.sobel_cordic)
         );
+    }
+}
+
+/// The soft-core program's own instructions for the costliest pair of the run: both cameras'
+/// `driver` counts (configuring, arming, draining, packetizing, framing), without the fabric's
+/// software stand-in (`front_end`) and without the waits for the emulated UART, which a
+/// link that keeps up does not cause. The budget is per pair, so the worst pair is the figure.
+fn softcore_instructions_per_pair(logs: &[stereocal_tools::hil::DeviceLog]) -> Option<u64> {
+    let mut per_frame = std::collections::BTreeMap::<u32, u64>::new();
+    for r in instruction_reports(logs) {
+        *per_frame.entry(r.frame).or_default() += r.driver;
+    }
+    per_frame.into_values().max()
+}
+
+#[cfg(test)]
+mod tests {
+    use stereocal_tools::hil::DeviceLog;
+
+    use super::softcore_instructions_per_pair;
+
+    fn report(frame: u32, camera: u8, driver: u64) -> DeviceLog {
+        DeviceLog {
+            seq: 0,
+            level: None,
+            text: format!(
+                "instructions: frame {frame} camera {camera} pixels 100 front_end 9999 \
+                 driver {driver} uart_wait 777"
+            ),
+        }
+    }
+
+    #[test]
+    fn the_costliest_pair_counts_both_cameras_and_nothing_of_the_fabric() {
+        let logs = [
+            report(0, 0, 10),
+            report(0, 1, 20),
+            report(1, 0, 25),
+            report(1, 1, 1),
+            DeviceLog {
+                seq: 1,
+                level: Some("info"),
+                text: "instructions: frame 1 camera 0 pixels 1 front_end 1 driver 1000 uart_wait 0"
+                    .into(),
+            },
+        ];
+        assert_eq!(softcore_instructions_per_pair(&logs), Some(30));
+        assert_eq!(softcore_instructions_per_pair(&[]), None);
     }
 }

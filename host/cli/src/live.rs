@@ -129,6 +129,7 @@ pub fn live(args: &LiveArgs) -> anyhow::Result<()> {
             out: Some(&args.out),
             json: args.json,
             title: &title,
+            json_extra: Default::default(),
         },
     )?;
     match stopped {

@@ -9,6 +9,7 @@ use stereocal::estimator::Model;
 use stereocal::misalignment::WindowConfig;
 use stereocal::session::SessionConfig;
 use stereocal_hdl::regs::output_mode::SobelOutput;
+use stereocal_synth::SequenceConfig;
 
 /// Essential-matrix model (`--model`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -157,5 +158,24 @@ fn parse_best(s: &str) -> Result<usize, String> {
         Err("must be at least 1".into())
     } else {
         Ok(n)
+    }
+}
+
+/// The rendered frame size (`--width`, `--height`), for the commands that render.
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct SizeArgs {
+    /// Rendered frame width in pixels (default: the scene's, 640).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    width: Option<u32>,
+    /// Rendered frame height in pixels (default: the scene's, 480).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    height: Option<u32>,
+}
+
+impl SizeArgs {
+    /// Sets the size in `config` where a flag gave one.
+    pub fn apply(&self, config: &mut SequenceConfig) {
+        config.width = self.width.unwrap_or(config.width);
+        config.height = self.height.unwrap_or(config.height);
     }
 }

@@ -18,6 +18,8 @@ pub struct Finish<'a> {
     pub json: bool,
     /// Title of the plot and the table.
     pub title: &'a str,
+    /// Fields the command adds to the JSON summary (e.g. `hil`'s instruction counts).
+    pub json_extra: serde_json::Map<String, serde_json::Value>,
 }
 
 /// A progress bar on stderr; indicatif hides it when stderr is not a terminal.
@@ -55,7 +57,11 @@ pub fn finish(
         None => Vec::new(),
     };
     if how.json {
-        println!("{}", serde_json::to_string_pretty(summary)?);
+        let mut json = serde_json::to_value(summary)?;
+        if let Some(object) = json.as_object_mut() {
+            object.extend(how.json_extra);
+        }
+        println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         // The latency does not depend on the Sobel output mode.
         let fabric = tuned_fabric_config(width as u16, height as u16, SobelOutput::Rows);

@@ -161,6 +161,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             out: Some(&args.out),
             json: args.json,
             title: &title,
+            json_extra: Default::default(),
         },
     )
 }

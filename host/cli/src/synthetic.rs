@@ -10,7 +10,7 @@ use stereocal::session::SessionConfig;
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
 use stereocal_tools::eval::evaluate;
 
-use crate::options::EstimateArgs;
+use crate::options::{EstimateArgs, SizeArgs};
 use crate::output::{finish, progress_bar, Finish};
 
 /// The sequence to render.
@@ -28,6 +28,8 @@ pub struct SceneArgs {
     /// Head motion (default: the scene's own: fixed on the road, manual moves elsewhere).
     #[arg(long)]
     trajectory: Option<TrajectoryKind>,
+    #[command(flatten)]
+    size: SizeArgs,
 }
 
 impl SceneArgs {
@@ -38,6 +40,7 @@ impl SceneArgs {
         if let Some(t) = self.trajectory {
             config.trajectory = t;
         }
+        self.size.apply(&mut config);
         Sequence::builtin(self.scene, config)
             .with_context(|| format!("cannot build the `{}` sequence", self.scene))
     }
@@ -98,6 +101,7 @@ pub fn eval(args: &EvalArgs) -> anyhow::Result<()> {
             out: args.out.as_deref(),
             json: args.json,
             title: &title,
+            json_extra: Default::default(),
         },
     )
 }
@@ -109,6 +113,7 @@ pub fn demo(args: &DemoArgs) -> anyhow::Result<()> {
         frames: args.frames,
         seed: args.seed,
         trajectory: Some(TrajectoryKind::Manual),
+        size: SizeArgs::default(),
     };
     let sequence = scene.sequence()?;
     let title = format!(
@@ -122,6 +127,7 @@ pub fn demo(args: &DemoArgs) -> anyhow::Result<()> {
             out: Some(&args.out),
             json: args.json,
             title: &title,
+            json_extra: Default::default(),
         },
     )
 }
