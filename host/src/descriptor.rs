@@ -25,6 +25,7 @@ pub enum DescriptorMode {
 }
 
 impl DescriptorMode {
+    /// Elements (bytes) per descriptor: 128 or 16.
     pub const fn dim(self) -> usize {
         match self {
             DescriptorMode::Full128 => 128,
@@ -48,6 +49,7 @@ impl DescriptorMode {
 /// Descriptor settings; the default is the most accurate one for a verge head.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DescriptorConfig {
+    /// Layout: the full 128 elements or the reduced 16.
     pub mode: DescriptorMode,
     /// Rotate the window to the keypoint's dominant gradient orientation.
     pub rotate: bool,
@@ -75,9 +77,11 @@ impl DescriptorSet {
     pub fn dim(&self) -> usize {
         self.dim
     }
+    /// Number of descriptors: one per keypoint whose gradient window is available.
     pub fn len(&self) -> usize {
         self.keypoints.len()
     }
+    /// True when the frame gave no descriptor.
     pub fn is_empty(&self) -> bool {
         self.keypoints.is_empty()
     }

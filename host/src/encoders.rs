@@ -4,40 +4,70 @@
 
 use std::path::{Path, PathBuf};
 
-/// The two accepted headers: the camera yaws (verge = left − right, toe-in positive, as the
-/// synthetic `frames.csv`), or the verge itself (a head that reports only that).
-pub const YAW_HEADER: [&str; 3] = ["frame", "left_yaw_deg", "right_yaw_deg"];
-pub const VERGE_HEADER: [&str; 2] = ["frame", "verge_deg"];
+/// Header of the first accepted form: the camera yaws in degrees (verge = left − right,
+/// toe-in positive, as the synthetic `frames.csv`).
+pub(crate) const YAW_HEADER: [&str; 3] = ["frame", "left_yaw_deg", "right_yaw_deg"];
+/// Header of the second: the verge itself, for a head that reports only that.
+pub(crate) const VERGE_HEADER: [&str; 2] = ["frame", "verge_deg"];
 
 /// An encoders file that could not be used, naming the file, the line and the field at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum EncodersError {
+    /// The file could not be opened or read, or a row is not CSV.
     #[error("{path}: cannot read encoders file: {source}")]
-    Read { path: PathBuf, source: csv::Error },
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The CSV reader's error.
+        source: csv::Error,
+    },
+    /// The header is neither of the two accepted forms.
     #[error(
         "{path}: header must be `frame,left_yaw_deg,right_yaw_deg` or `frame,verge_deg`, found `{found}`"
     )]
-    Header { path: PathBuf, found: String },
+    Header {
+        /// The file.
+        path: PathBuf,
+        /// The header found, fields joined by commas.
+        found: String,
+    },
+    /// A field does not parse: a frame that is not a non-negative integer, or an angle that is
+    /// not a finite number.
     #[error("{path}:{line}: field `{field}`: `{value}` is not {expected}")]
     Field {
+        /// The file.
         path: PathBuf,
+        /// 1-based line of the row.
         line: u64,
+        /// The column's name in the header.
         field: &'static str,
+        /// The field's text.
         value: String,
+        /// What the field must be (`a finite number of degrees`).
         expected: &'static str,
     },
+    /// A frame index that does not increase on the row before.
     #[error("{path}:{line}: frame {found} does not follow frame {previous}; frames must increase")]
     Order {
+        /// The file.
         path: PathBuf,
+        /// 1-based line of the row.
         line: u64,
+        /// The row's frame index.
         found: usize,
+        /// The frame index of the row before.
         previous: usize,
     },
+    /// A frame index past the end of the sequence.
     #[error("{path}:{line}: frame {found} is beyond the sequence's {frames} frames")]
     Beyond {
+        /// The file.
         path: PathBuf,
+        /// 1-based line of the row.
         line: u64,
+        /// The row's frame index.
         found: usize,
+        /// Frames in the sequence.
         frames: usize,
     },
 }

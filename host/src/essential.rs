@@ -32,7 +32,9 @@ use crate::calib::Calibration;
 /// One match in calibrated coordinates: the rays (x, y, 1) of the left and right camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Correspondence {
+    /// The left camera's ray `(x, y)` at z = 1, undistorted.
     pub left: [f64; 2],
+    /// The right camera's ray `(x, y)` at z = 1, undistorted.
     pub right: [f64; 2],
     /// Relative weight in the refinement (inverse variance, 1 = nominal).
     pub weight: f64,
@@ -65,7 +67,12 @@ impl Correspondence {
 pub enum EssentialError {
     /// Fewer matches than the model needs.
     #[error("{got} matches, the model needs at least {need}")]
-    TooFewMatches { got: usize, need: usize },
+    TooFewMatches {
+        /// Matches given.
+        got: usize,
+        /// The model's minimum.
+        need: usize,
+    },
     /// The matches do not constrain the model (e.g. all on the horizon row, or NaN input).
     #[error("degenerate match configuration")]
     Degenerate,
@@ -135,6 +142,7 @@ impl RobustLoss {
 /// Settings of the iterative (Gauss-Newton IRLS) refinements.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefineConfig {
+    /// The M-estimator whose IRLS weights each iteration applies.
     pub loss: RobustLoss,
     /// Maximum Gauss-Newton iterations.
     pub max_iterations: usize,

@@ -37,7 +37,9 @@ pub enum Model {
 /// Settings of the whole per-frame estimate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EstimatorConfig {
+    /// Descriptor layout and rotation.
     pub descriptor: DescriptorConfig,
+    /// Descriptor matching: the vertical band, the ratio test, the left-right check.
     pub matching: MatchConfig,
     /// Sub-pixel refinement on the octave-0 Sobel planes (skipped for patch frames).
     pub subpixel: Option<SubpixelConfig>,
@@ -45,7 +47,9 @@ pub struct EstimatorConfig {
     pub ransac: Option<RansacConfig>,
     /// RANSAC inlier threshold in pixels.
     pub ransac_threshold_px: f64,
+    /// The robust refinement that gives the estimate and its uncertainty.
     pub refine: RefineConfig,
+    /// The essential-matrix model the refinement fits.
     pub model: Model,
     /// Fewer matches (after refinement) or inliers than this → no estimate for the frame.
     pub min_matches: usize,
@@ -106,8 +110,16 @@ impl Default for EstimatorConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum EstimateError {
+    /// Fewer point pairs entered the estimate, or fewer were consistent with it, than
+    /// `min_matches`.
     #[error("only {got} usable matches (need {need})")]
-    TooFewMatches { got: usize, need: usize },
+    TooFewMatches {
+        /// Point pairs, or inliers of the estimate.
+        got: usize,
+        /// `EstimatorConfig::min_matches`.
+        need: usize,
+    },
+    /// The essential-matrix solve or RANSAC failed.
     #[error(transparent)]
     Essential(#[from] EssentialError),
 }
@@ -151,10 +163,12 @@ pub struct VergeEstimator {
 }
 
 impl VergeEstimator {
+    /// An estimator for the head `calib` describes.
     pub fn new(calib: Calibration, config: EstimatorConfig) -> Self {
         Self { calib, config }
     }
 
+    /// The settings it was made with.
     pub fn config(&self) -> &EstimatorConfig {
         &self.config
     }

@@ -19,27 +19,53 @@ pub const ORIENTATION_STEPS: u8 = 64;
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum FeatureError {
+    /// A Sobel plane's magnitude or orientation samples do not number `width·height`.
     #[error(
         "Sobel plane of octave {octave}: {len} magnitude/orientation samples for {width}x{height}"
     )]
     PlaneSize {
+        /// The plane's octave.
         octave: u8,
+        /// The plane's width in octave pixels.
         width: u32,
+        /// The plane's height in octave pixels.
         height: u32,
+        /// Samples given: the shorter of the magnitude and orientation vectors.
         len: usize,
     },
+    /// An orientation code of 64 or more: the fabric's codes have 6 bits.
     #[error(
         "Sobel plane of octave {octave}: orientation code {code} at index {index} is not 6-bit"
     )]
-    OrientationRange { octave: u8, index: usize, code: u8 },
+    OrientationRange {
+        /// The plane's octave.
+        octave: u8,
+        /// Row-major index of the first such sample.
+        index: usize,
+        /// Its code.
+        code: u8,
+    },
+    /// Patch gradients that are not one per keypoint.
     #[error("{patches} gradient patches for {keypoints} keypoints")]
-    PatchCount { patches: usize, keypoints: usize },
+    PatchCount {
+        /// Patches given.
+        patches: usize,
+        /// Keypoints given.
+        keypoints: usize,
+    },
+    /// A keypoint that is not finite or lies outside the image (more than half a pixel
+    /// beyond the outer pixel centres).
     #[error("keypoint {index}: coordinates ({x}, {y}) are not finite or outside {width}x{height}")]
     KeypointPosition {
+        /// Index of the keypoint in the frame.
         index: usize,
+        /// Its full-resolution x in pixels.
         x: f32,
+        /// Its full-resolution y in pixels.
         y: f32,
+        /// Image width in full-resolution pixels.
         width: u32,
+        /// Image height in full-resolution pixels.
         height: u32,
     },
 }
@@ -136,18 +162,23 @@ impl SobelPlane {
         })
     }
 
+    /// Pyramid octave of the plane (0 = full resolution).
     pub fn octave(&self) -> u8 {
         self.octave
     }
+    /// Width in pixels of the plane's octave.
     pub fn width(&self) -> u32 {
         self.width
     }
+    /// Height in pixels of the plane's octave.
     pub fn height(&self) -> u32 {
         self.height
     }
+    /// Gradient magnitudes, row-major: the fabric's 8-bit `x_n·5/8`.
     pub fn magnitude(&self) -> &[u8] {
         &self.magnitude
     }
+    /// Gradient orientations, row-major: 6-bit codes `k`, angle `k·360/64°` from +x toward +y.
     pub fn orientation(&self) -> &[u8] {
         &self.orientation
     }
@@ -167,7 +198,9 @@ impl SobelPlane {
 /// octave position rounded to the nearest pixel. Samples outside the image are 0.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SobelPatch {
+    /// Gradient magnitudes, the fabric's 8-bit `x_n·5/8`.
     pub magnitude: [u8; PATCH_SIZE * PATCH_SIZE],
+    /// Gradient orientations, 6-bit codes `k`, angle `k·360/64°` from +x toward +y.
     pub orientation: [u8; PATCH_SIZE * PATCH_SIZE],
 }
 
@@ -187,8 +220,9 @@ pub struct FeatureFrame {
     pub index: u64,
     /// Capture time in microseconds (drives the Kalman prediction).
     pub timestamp_us: u64,
-    /// Full-resolution image size.
+    /// Full-resolution image width in pixels.
     pub width: u32,
+    /// Full-resolution image height in pixels.
     pub height: u32,
     keypoints: Vec<Keypoint>,
     gradients: Gradients,
@@ -239,10 +273,13 @@ impl FeatureFrame {
         })
     }
 
+    /// The keypoints in the order the device sent them; [`Gradients::Patches`] and
+    /// descriptor indices refer to this order.
     pub fn keypoints(&self) -> &[Keypoint] {
         &self.keypoints
     }
 
+    /// The Sobel planes or patches that came with the frame.
     pub fn gradients(&self) -> &Gradients {
         &self.gradients
     }

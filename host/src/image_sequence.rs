@@ -10,60 +10,109 @@ use std::path::{Path, PathBuf};
 /// An 8-bit grey image, row-major.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct GrayFrame {
+    /// Image width in pixels.
     pub width: usize,
+    /// Image height in pixels.
     pub height: usize,
+    /// `width·height` grey levels, row-major from the top-left pixel.
     pub pixels: Vec<u8>,
 }
 
 /// A stereo sequence that cannot be read, naming the directory, file or frame at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum SequenceError {
+    /// A camera's directory does not exist or is not a directory.
     #[error("{camera} image directory {path} does not exist or is not a directory")]
-    MissingDir { camera: &'static str, path: PathBuf },
+    MissingDir {
+        /// `left` or `right`.
+        camera: &'static str,
+        /// The directory.
+        path: PathBuf,
+    },
+    /// A camera's directory could not be listed.
     #[error("{camera} image directory {path} cannot be listed: {source}")]
     ListDir {
+        /// `left` or `right`.
         camera: &'static str,
+        /// The directory.
         path: PathBuf,
+        /// The operating system's error.
         source: std::io::Error,
     },
+    /// A camera's directory holds no image file.
     #[error("{camera} image directory {path} holds no .png, .pgm, .jpg or .jpeg files")]
-    Empty { camera: &'static str, path: PathBuf },
+    Empty {
+        /// `left` or `right`.
+        camera: &'static str,
+        /// The directory.
+        path: PathBuf,
+    },
+    /// The two directories hold different numbers of images.
     #[error("left directory has {left} images but right directory has {right}; frames are paired by sorted name")]
-    CountMismatch { left: usize, right: usize },
+    CountMismatch {
+        /// Images in the left directory.
+        left: usize,
+        /// Images in the right directory.
+        right: usize,
+    },
+    /// An image file could not be read or decoded.
     #[error("{path}: cannot decode image: {source}")]
     Decode {
+        /// The file.
         path: PathBuf,
+        /// The `image` crate's error (a read error as its `IoError`).
         source: image::ImageError,
     },
+    /// The two images of a pair differ in size.
     #[error("frame {frame}: left image {left_w}x{left_h} and right image {right_w}x{right_h} differ in size")]
     PairSize {
+        /// 0-based index of the pair.
         frame: usize,
+        /// Left image width in pixels.
         left_w: usize,
+        /// Left image height in pixels.
         left_h: usize,
+        /// Right image width in pixels.
         right_w: usize,
+        /// Right image height in pixels.
         right_h: usize,
     },
+    /// A pair's size differs from the first pair's.
     #[error("frame {frame}: image size {width}x{height} differs from the first frame's {first_w}x{first_h}")]
     SizeChanged {
+        /// 0-based index of the pair.
         frame: usize,
+        /// Its width in pixels.
         width: usize,
+        /// Its height in pixels.
         height: usize,
+        /// The first pair's width in pixels.
         first_w: usize,
+        /// The first pair's height in pixels.
         first_h: usize,
     },
+    /// The images are wider than the fabric's line buffers.
     #[error(
         "frame {frame}: image is {width} px wide; the fabric's line buffers hold at most {max} px"
     )]
     TooWide {
+        /// 0-based index of the pair.
         frame: usize,
+        /// Its width in pixels.
         width: usize,
+        /// [`SizeLimits::max_width`].
         max: usize,
     },
+    /// A side of the images is shorter than the pyramid needs.
     #[error("frame {frame}: image is {width}x{height}; the pyramid needs at least {min}x{min}")]
     TooSmall {
+        /// 0-based index of the pair.
         frame: usize,
+        /// Its width in pixels.
         width: usize,
+        /// Its height in pixels.
         height: usize,
+        /// [`SizeLimits::min_side`].
         min: usize,
     },
 }
@@ -93,7 +142,9 @@ impl GrayFrame {
 /// Limits the fabric puts on the image size.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SizeLimits {
+    /// Widest image in pixels: the length of the fabric's line buffers.
     pub max_width: usize,
+    /// Shortest side in pixels that the pyramid accepts.
     pub min_side: usize,
 }
 

@@ -89,6 +89,7 @@ impl Default for KalmanConfig {
 /// One per-frame verge measurement.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Measurement {
+    /// The frame's raw verge in degrees, toe-in positive.
     pub verge_deg: f64,
     /// The estimator's own 1-σ uncertainty (deg).
     pub sigma_deg: f64,
@@ -112,12 +113,15 @@ pub enum FilterStatus {
 /// The filter's output for one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FilterOutput {
+    /// Filtered verge in degrees, toe-in positive (`filtered_verge_deg` in the CSV).
     pub verge_deg: f64,
+    /// Filtered verge rate in degrees per second, of the models' mixture.
     pub rate_deg_s: f64,
     /// 1-σ of the filtered verge (`filtered_sigma_deg` in the CSV).
     pub sigma_deg: f64,
     /// Probability that the head is turning (the turning model's weight).
     pub turning_probability: f64,
+    /// What the filter did with the frame.
     pub status: FilterStatus,
 }
 
@@ -125,7 +129,9 @@ pub struct FilterOutput {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("frame timestamp {now_us} µs is before the previous one ({previous_us} µs)")]
 pub struct TimeWentBackwards {
+    /// The previous frame's timestamp in microseconds.
     pub previous_us: u64,
+    /// The offending frame's timestamp in microseconds.
     pub now_us: u64,
 }
 
@@ -174,6 +180,7 @@ pub struct VergeFilter {
 }
 
 impl VergeFilter {
+    /// A filter that has seen no measurement yet.
     pub fn new(config: KalmanConfig) -> Self {
         Self {
             config,

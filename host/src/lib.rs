@@ -23,6 +23,8 @@
 //! ([`image_sequence`]). The data path, frames and signs and every file format are in
 //! `docs/ARCHITECTURE.md`.
 
+#![warn(missing_docs)]
+
 pub mod calib;
 pub mod descriptor;
 pub mod driver;

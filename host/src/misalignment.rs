@@ -58,11 +58,19 @@ impl Default for WindowConfig {
 /// fit's covariance (0 for an angle held at the calibration's).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct MisalignmentEstimate {
+    /// The right camera's pitch, the `Rx` angle of `R_01` (docs/ARCHITECTURE.md, "Frames and
+    /// signs").
     pub pitch_deg: f64,
+    /// The right camera's roll, the `Rz` angle of `R_01`.
     pub roll_deg: f64,
+    /// The baseline's elevation, positive when the right camera sits lower (+y); the
+    /// calibration's unless the window fits it (`window-tilt`).
     pub baseline_tilt_deg: f64,
+    /// 1-σ of `pitch_deg`.
     pub pitch_sigma_deg: f64,
+    /// 1-σ of `roll_deg`.
     pub roll_sigma_deg: f64,
+    /// 1-σ of `baseline_tilt_deg`; 0 when it is held.
     pub baseline_tilt_sigma_deg: f64,
     /// Frames in the window that gave it.
     pub frames: usize,

@@ -55,16 +55,18 @@ impl Default for RansacConfig {
 /// What RANSAC found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RansacResult {
+    /// The best-supported hypothesis.
     pub angles: VergeAngles,
     /// Per match: consistent with `angles` within the threshold.
     pub inliers: Vec<bool>,
+    /// Matches in `inliers` that are true.
     pub inlier_count: usize,
     /// Samples drawn.
     pub iterations: usize,
 }
 
 /// The ≤ 2 constrained hypotheses through two matches (module doc).
-pub fn minimal_solutions(c0: &Correspondence, c1: &Correspondence) -> heapless_pair::Pair {
+pub(crate) fn minimal_solutions(c0: &Correspondence, c1: &Correspondence) -> heapless_pair::Pair {
     let row = |c: &Correspondence| {
         let [ul, vl] = c.left;
         let [ur, vr] = c.right;
@@ -113,7 +115,7 @@ pub fn minimal_solutions(c0: &Correspondence, c1: &Correspondence) -> heapless_p
 }
 
 /// A tiny fixed-capacity list of at most two hypotheses (no allocation in the hot loop).
-pub mod heapless_pair {
+pub(crate) mod heapless_pair {
     use crate::essential::constrained::VergeAngles;
 
     #[derive(Debug, Default, Clone, Copy)]

@@ -25,7 +25,9 @@ use crate::output::summary::RunCost;
 /// Settings of a session.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SessionConfig {
+    /// The per-pair estimate.
     pub estimator: EstimatorConfig,
+    /// The filter over the pairs' raw verges.
     pub kalman: KalmanConfig,
     /// Which Sobel output the fabric streams (full rows, as the thesis, or 16x16 patches).
     pub sobel_output: SobelOutput,
@@ -66,29 +68,46 @@ pub fn tuned_fabric_config(width: u16, height: u16, sobel_output: SobelOutput) -
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SessionError {
+    /// Opening the device, or handing it a pair's pixels, failed.
     #[error("device link: {0}")]
     Link(#[from] LinkError),
+    /// The host driver failed: Hello or the configuration went wrong, the link failed under
+    /// it, or no pair came to [`Session::receive`] within the answer timeout.
     #[error("device: {0}")]
     Driver(#[from] DriverError),
+    /// A pair's capture time is before the previous pair's.
     #[error("frame {frame}: {source}")]
     Time {
+        /// The session frame index of the pair.
         frame: usize,
+        /// The two timestamps.
         source: TimeWentBackwards,
     },
+    /// The device delivered a newer frame id than any pair submitted: host and device
+    /// disagree about which images they are.
     #[error("frame {frame}: the device answered with frame id {got}, expected {expected}")]
     OutOfStep {
+        /// The session frame index of the pair.
         frame: usize,
+        /// The device's frame id that arrived.
         got: u32,
+        /// The device's frame id of the pair submitted.
         expected: u32,
     },
+    /// A pair's size is not the size the fabric was configured for.
     #[error(
         "frame {frame}: image is {width}x{height}, the fabric was configured for {configured_w}x{configured_h}"
     )]
     SizeChanged {
+        /// The session frame index of the pair.
         frame: usize,
+        /// Its width in pixels.
         width: usize,
+        /// Its height in pixels.
         height: usize,
+        /// The fabric's configured width in pixels.
         configured_w: u16,
+        /// The fabric's configured height in pixels.
         configured_h: u16,
     },
 }
@@ -96,6 +115,7 @@ pub enum SessionError {
 /// What was spent on the pairs processed so far.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SessionCost {
+    /// Pairs recorded, dropped ones included.
     pub pairs: usize,
     /// Wall time inside [`Session::process`] (device, driver, estimator, filter).
     pub elapsed: Duration,
@@ -117,6 +137,7 @@ impl From<SessionCost> for RunCost {
 }
 
 impl SessionCost {
+    /// Milliseconds of [`SessionCost::elapsed`] per pair; 0 before the first.
     pub fn ms_per_pair(&self) -> f64 {
         if self.pairs == 0 {
             0.0
@@ -134,6 +155,7 @@ impl SessionCost {
         }
     }
 
+    /// Link bytes per pair (see [`SessionCost::wire_bytes`]); 0 before the first.
     pub fn wire_bytes_per_pair(&self) -> f64 {
         if self.pairs == 0 {
             0.0

@@ -47,7 +47,9 @@ impl Default for SubpixelConfig {
 /// A refined point pair in octave-0 (full-resolution) pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefinedPair {
+    /// The left point `(x, y)`, snapped to its nearest octave-0 pixel.
     pub left: [f32; 2],
+    /// The right point `(x, y)` where its window best matches the left one.
     pub right: [f32; 2],
     /// Estimated 1-σ vertical position error of `right` (pixels).
     pub sigma_v: f32,

@@ -34,7 +34,9 @@ pub enum CalibError {
     /// The file could not be read or written.
     #[error("calibration {path}: {source}")]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The operating system's error.
         #[source]
         source: std::io::Error,
     },
@@ -42,12 +44,20 @@ pub enum CalibError {
     /// TOML parser's message names the key, the expected type and the line); or the YAML of an
     /// OpenCV or Kalibr file is malformed (the YAML parser's message names the line).
     #[error("calibration {path}: {message}")]
-    Parse { path: PathBuf, message: String },
+    Parse {
+        /// The file, or the origin the text was given under.
+        path: PathBuf,
+        /// The parser's message.
+        message: String,
+    },
     /// A value parsed but is physically impossible (e.g. a focal length ≤ 0).
     #[error("calibration {path}: key `{key}` {reason}")]
     Invalid {
+        /// The file, or the origin the text was given under.
         path: PathBuf,
+        /// The offending key, dotted as in the TOML (`right.fy`, `extrinsics.pitch_deg`).
         key: &'static str,
+        /// What the value must be, worded to follow the key (`must be a finite value > 0`).
         reason: &'static str,
     },
     /// A key of an OpenCV, Kalibr or KITTI file is missing, malformed or unsupported; `key`
@@ -57,9 +67,13 @@ pub enum CalibError {
         .line.map(|l| format!("line {l}: ")).unwrap_or_default()
     )]
     Key {
+        /// The file, or the origin the text was given under.
         path: PathBuf,
+        /// The key as the file's own format names it.
         key: String,
+        /// 1-based line of the key, when the format has lines.
         line: Option<usize>,
+        /// What is wrong with it, worded to follow the key (`is missing`).
         reason: String,
     },
 }
@@ -85,9 +99,13 @@ fn number(text: &str) -> Option<f64> {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraIntrinsics {
+    /// Horizontal focal length in pixels, > 0.
     pub fx: f64,
+    /// Vertical focal length in pixels, > 0.
     pub fy: f64,
+    /// Principal point's x in pixels (pixel centres at integers).
     pub cx: f64,
+    /// Principal point's y in pixels (pixel centres at integers).
     pub cy: f64,
     /// Radial distortion, OpenCV `k1` (extension; 0 when absent).
     #[serde(default, skip_serializing_if = "is_zero")]
@@ -249,7 +267,9 @@ impl Side {
 pub struct Calibration {
     /// Distance between the optical centres in metres; the right camera sits at (+b, 0, 0).
     pub baseline_m: f64,
+    /// The left camera, whose frame at zero yaw is the head frame.
     pub left: CameraIntrinsics,
+    /// The right camera.
     pub right: CameraIntrinsics,
     /// The pose at calibration time (extension; all zero, and absent from the TOML, for a
     /// rectified pair).

@@ -242,14 +242,23 @@ pub enum ContentError {
 /// Counts of dropped frames by reason (one per [`Damage`] variant).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct DamageCounts {
+    /// Frames dropped for [`Damage::SequenceGap`].
     pub sequence_gap: u64,
+    /// Frames dropped for [`Damage::Undecodable`].
     pub undecodable: u64,
+    /// Frames dropped for [`Damage::OverLong`].
     pub over_long: u64,
+    /// Frames dropped for [`Damage::Truncated`].
     pub truncated: u64,
+    /// Frames dropped for [`Damage::MissingStart`].
     pub missing_start: u64,
+    /// Frames dropped for [`Damage::Foreign`].
     pub foreign: u64,
+    /// Frames dropped for [`Damage::CountMismatch`].
     pub count_mismatch: u64,
+    /// Frames dropped for [`Damage::Content`].
     pub content: u64,
+    /// Frames dropped for [`Damage::Assembly`].
     pub assembly: u64,
 }
 

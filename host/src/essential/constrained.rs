@@ -20,6 +20,7 @@ pub struct VergeAngles {
 }
 
 impl VergeAngles {
+    /// The yaws `alpha_l` and `alpha_r`, in radians.
     pub fn new(alpha_l: f64, alpha_r: f64) -> Self {
         Self { alpha_l, alpha_r }
     }
@@ -166,6 +167,7 @@ pub fn enforce_and_resolve(e: [f64; 4]) -> Result<VergeAngles, EssentialError> {
 /// The result of the robust refinement.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConstrainedFit {
+    /// The refined yaws of both cameras.
     pub angles: VergeAngles,
     /// Standard deviation of the verge angle from the Gauss-Newton covariance (radians).
     pub verge_sigma: f64,
@@ -178,6 +180,7 @@ pub struct ConstrainedFit {
 }
 
 impl ConstrainedFit {
+    /// Matches counted as inliers.
     pub fn inlier_count(&self) -> usize {
         self.inliers.iter().filter(|&&b| b).count()
     }

@@ -26,8 +26,11 @@ pub struct RelativePose {
 /// `geometry.json`: `docs/ARCHITECTURE.md`, "Real data").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct YawPitchRoll {
+    /// Rotation about y; `-yaw` is the verge, toe-in positive.
     pub yaw: f64,
+    /// Rotation about x, applied after roll.
     pub pitch: f64,
+    /// Rotation about z (the optical axis), applied first.
     pub roll: f64,
 }
 
@@ -113,16 +116,20 @@ fn tangent_basis(t: &Unit<Vector3<f64>>) -> (Vector3<f64>, Vector3<f64>) {
 /// The result of the general refinement.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GeneralFit {
+    /// The refined relative pose.
     pub pose: RelativePose,
     /// Standard deviation of the verge angle from the Gauss-Newton covariance (radians).
     pub verge_sigma: f64,
     /// Robust noise scale of the Sampson residuals (calibrated units).
     pub residual_sigma: f64,
+    /// Per match: weighted |Sampson residual| below `inlier_sigmas`·σ.
     pub inliers: Vec<bool>,
+    /// Gauss-Newton iterations run.
     pub iterations: usize,
 }
 
 impl GeneralFit {
+    /// Matches counted as inliers.
     pub fn inlier_count(&self) -> usize {
         self.inliers.iter().filter(|&&b| b).count()
     }

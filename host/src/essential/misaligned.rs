@@ -21,8 +21,11 @@ use crate::calib::Extrinsics;
 /// lower (+y).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Misalignment {
+    /// The right camera's pitch, the `Rx` angle of `R_01`.
     pub pitch: f64,
+    /// The right camera's roll, the `Rz` angle of `R_01`.
     pub roll: f64,
+    /// The baseline's elevation, positive when the right camera sits lower (+y).
     pub tilt: f64,
 }
 
@@ -41,7 +44,8 @@ impl Misalignment {
         Vector3::new(self.pitch, self.roll, self.tilt)
     }
 
-    pub fn from_vector(v: &Vector3<f64>) -> Self {
+    /// From a vector `(pitch, roll, tilt)`, the inverse of [`Self::to_vector`].
+    pub(crate) fn from_vector(v: &Vector3<f64>) -> Self {
         Self {
             pitch: v[0],
             roll: v[1],
@@ -120,6 +124,7 @@ pub fn residual_and_gradient<const K: usize>(
 /// The yaws of one frame refined with the misalignments held.
 #[derive(Debug, Clone, PartialEq)]
 pub struct YawFit {
+    /// The refined yaws of both cameras.
     pub angles: VergeAngles,
     /// Standard deviation of the verge from the Gauss-Newton covariance, radians; it treats
     /// the misalignments as known.

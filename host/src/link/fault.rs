@@ -96,11 +96,17 @@ impl FaultConfig {
 pub struct FaultCounts {
     /// Packets (delimited runs of bytes) that went through while faults were on.
     pub packets: u64,
+    /// Bits inverted.
     pub bits_flipped: u64,
+    /// Bytes removed.
     pub bytes_dropped: u64,
+    /// Packets that lost a tail.
     pub packets_truncated: u64,
+    /// Packets sent twice.
     pub packets_duplicated: u64,
+    /// Packets held back to go out after their successor.
     pub packets_reordered: u64,
+    /// Stalls inserted before a packet.
     pub stalls: u64,
     /// Most bytes the wrapper held at once (incoming, held back and outgoing): the bound on
     /// its memory, one delivery of the wrapped link plus one packet.

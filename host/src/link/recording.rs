@@ -13,6 +13,7 @@ pub struct Recording<L> {
 }
 
 impl<L> Recording<L> {
+    /// Wraps `inner`, with nothing received yet.
     pub fn new(inner: L) -> Self {
         Self {
             inner,

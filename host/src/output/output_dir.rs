@@ -17,8 +17,11 @@ pub const STAGING_PREFIX: &str = ".stereocal-staging-";
 #[derive(Debug, thiserror::Error)]
 #[error("{path}: {action}: {source}")]
 pub struct OutputError {
+    /// The directory or file the action was on.
     pub path: PathBuf,
+    /// What failed (`cannot create output directory`).
     pub action: &'static str,
+    /// The operating system's error.
     pub source: std::io::Error,
 }
 

@@ -20,7 +20,9 @@ pub const FAMILY: &str = "sans-serif";
 #[derive(Debug, thiserror::Error)]
 #[error("{path}: cannot draw the verge plot: {message}")]
 pub struct PlotError {
+    /// The figure's file.
     pub path: std::path::PathBuf,
+    /// The plotting library's message.
     pub message: String,
 }
 

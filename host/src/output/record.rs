@@ -57,6 +57,7 @@ pub struct FrameRecord {
     pub keypoints_per_octave: Vec<usize>,
     /// `matches` by the octave of the left keypoint, empty unless `status` is `Ok`.
     pub matches_per_octave: Vec<usize>,
+    /// Whether the pair gave a measurement (`status` in `verge.csv`).
     pub status: FrameStatus,
     /// Ground-truth verge, when a truth file or the renderer gives it.
     pub truth_deg: Option<f64>,

@@ -14,15 +14,26 @@ use crate::output::verge_csv::write_verge_csv;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ReportError {
+    /// The output directory could not be prepared, or the files not moved into place.
     #[error(transparent)]
     Output(#[from] OutputError),
+    /// `verge.png` could not be drawn or written.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// `verge.csv` could not be written.
     #[error("{path}: cannot write the verge CSV: {source}")]
-    Csv { path: PathBuf, source: csv::Error },
+    Csv {
+        /// Its destination in the output directory.
+        path: PathBuf,
+        /// The CSV writer's error.
+        source: csv::Error,
+    },
+    /// `verge.csv` could not be created in the staging directory.
     #[error("{path}: cannot create the verge CSV: {source}")]
     Create {
+        /// Its destination in the output directory.
         path: PathBuf,
+        /// The operating system's error.
         source: std::io::Error,
     },
 }

@@ -23,20 +23,31 @@ pub fn settled_from(frames: usize) -> usize {
 /// known up to that constant, so it is estimated (median) and removed before the statistics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Residual {
+    /// The truth is exact (rendered sequences): the offset counts as error.
     Keep,
+    /// The truth is known up to a constant (`run --truth`): the median offset is removed.
     Remove,
 }
 
 /// The JSON object `--json` prints: the fields the CLI contract names, then ours.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Summary {
+    /// Frame pairs in the run.
     pub frames: usize,
+    /// Pairs with status `ok`.
     pub estimated_frames: usize,
+    /// Median |raw verge − truth| in degrees, after removing `residual_removed_deg`; `None`
+    /// without truth or estimates.
     pub median_abs_err_deg: Option<f64>,
+    /// 95th percentile of the same error, degrees.
     pub p95_abs_err_deg: Option<f64>,
+    /// Largest of the same error, degrees.
     pub max_abs_err_deg: Option<f64>,
+    /// Median |filtered verge − truth| in degrees, after removing `residual_removed_deg`.
     pub filtered_median_abs_err_deg: Option<f64>,
+    /// Largest of the same error, degrees.
     pub filtered_max_abs_err_deg: Option<f64>,
+    /// Wall time of the whole chain per pair, milliseconds.
     pub ms_per_frame_pair: f64,
     /// Frames that never arrived intact.
     pub dropped_frames: usize,
@@ -58,7 +69,9 @@ pub struct Summary {
 /// Work measured while producing the records.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunCost {
+    /// Wall time of the whole chain per pair, milliseconds.
     pub ms_per_frame_pair: f64,
+    /// Bytes on the link per pair, both cameras.
     pub wire_bytes_per_pair: f64,
 }
 

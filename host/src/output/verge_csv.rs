@@ -26,20 +26,41 @@ pub const TRUTH_HEADER: [&str; 2] = ["frame", "verge_deg"];
 /// A ground-truth file that could not be used, naming the file and the line at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum TruthError {
+    /// The file could not be opened or read, or a row is not CSV.
     #[error("{path}: cannot read truth file: {source}")]
-    Read { path: PathBuf, source: csv::Error },
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The CSV reader's error.
+        source: csv::Error,
+    },
+    /// The header is not `frame,verge_deg`.
     #[error("{path}: header must be `frame,verge_deg`, found `{found}`")]
-    Header { path: PathBuf, found: String },
+    Header {
+        /// The file.
+        path: PathBuf,
+        /// The header found, fields joined by commas.
+        found: String,
+    },
+    /// A field does not parse: a frame that is not a non-negative integer, or a verge that is
+    /// not a finite number.
     #[error("{path}:{line}: {problem}")]
     Row {
+        /// The file.
         path: PathBuf,
+        /// 1-based line of the row.
         line: u64,
+        /// The field and its text, and what it must be.
         problem: String,
     },
+    /// A frame number that is not the next one (0, 1, 2, …).
     #[error("{path}: frames must be 0, 1, 2, … in order; line {line} has frame {found}")]
     Order {
+        /// The file.
         path: PathBuf,
+        /// 1-based line of the row.
         line: u64,
+        /// The row's frame number.
         found: usize,
     },
 }
