@@ -68,7 +68,11 @@ fn frames(rows: &[Vec<SobelPixel>]) -> Vec<Vec<u8>> {
 fn encode_all(rows: &[Vec<SobelPixel>], buf: &mut [u8]) -> usize {
     rows.iter()
         .enumerate()
-        .map(|(y, pixels)| encode(Source::Left, y as u16, &repr(y, pixels), buf).unwrap().len())
+        .map(|(y, pixels)| {
+            encode(Source::Left, y as u16, &repr(y, pixels), buf)
+                .unwrap()
+                .len()
+        })
         .sum()
 }
 

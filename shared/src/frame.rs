@@ -107,9 +107,7 @@ impl From<Error> for Rejected {
 
 /// [`decode`] of COBS bytes known to hold no `0x00` (the [`Accumulator`](crate::Accumulator)
 /// cuts its frames at the zeros, so it need not scan them again).
-pub(crate) fn decode_zero_free(
-    encoded: &mut [u8],
-) -> Result<(Header, PacketRepr<'_>), Rejected> {
+pub(crate) fn decode_zero_free(encoded: &mut [u8]) -> Result<(Header, PacketRepr<'_>), Rejected> {
     let packet = cobs_in_place::decode_in_place(encoded).ok_or(Error::DecodeBadCobs)?;
     let encoded: &[u8] = encoded;
     parse_packet(encoded.get(packet).ok_or(Error::DecodeBadCobs)?)

@@ -142,7 +142,9 @@ fn long_nonzero_runs_encode_like_the_cobs_crate() {
         });
         for repr in [log, rows] {
             let mut buf = [0u8; MAX_FRAME_LEN];
-            let mut frame = encode(Source::Unknown(0xff), 0xffff, &repr, &mut buf).unwrap().to_vec();
+            let mut frame = encode(Source::Unknown(0xff), 0xffff, &repr, &mut buf)
+                .unwrap()
+                .to_vec();
             let body = &frame[..frame.len() - 1];
             let mut raw = vec![0u8; body.len()];
             let raw_len = cobs::decode(body, &mut raw).unwrap().frame_size();

@@ -334,7 +334,11 @@ fn spec_vectors_match_the_code() {
             Some(block) if *block == expected => {
                 let mut frame = block.frame.clone();
                 let (header, decoded) = decode(&mut frame).expect("spec frame decodes");
-                assert_eq!((header.source, header.seq), (*source, *seq), "vector {name}");
+                assert_eq!(
+                    (header.source, header.seq),
+                    (*source, *seq),
+                    "vector {name}"
+                );
                 assert_eq!(&decoded, repr, "vector {name}");
             }
             _ => report += &render(name, &expected),

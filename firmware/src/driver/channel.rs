@@ -576,5 +576,6 @@ fn send<S: ByteSink>(
     numbering: &mut Numbering,
     packet: &PacketRepr<'_>,
 ) -> Result<(), DriverError> {
-    out.send_from(numbering, packet).map_err(DriverError::Encode)
+    out.send_from(numbering, packet)
+        .map_err(DriverError::Encode)
 }

@@ -26,7 +26,6 @@ mod fault;
 mod in_process;
 mod own_cameras;
 mod recording;
-mod renumber;
 mod replay;
 mod serial;
 mod stream;

@@ -105,7 +105,10 @@ mod tests {
     fn detail_holds_cause_and_value() {
         let detail = FrameFailure::NotArmed.detail(0);
         assert_eq!(detail, 0x0900_0000);
-        assert_eq!(FrameFailure::from_detail(detail), (FrameFailure::NotArmed, 0));
+        assert_eq!(
+            FrameFailure::from_detail(detail),
+            (FrameFailure::NotArmed, 0)
+        );
         let detail = FrameFailure::ImageSize.detail(0x0123_4567);
         assert_eq!(detail, 0x04ff_ffff);
         assert_eq!(
