@@ -11,7 +11,7 @@ use stereocal::driver::{
 };
 use stereocal::features::Gradients;
 use stereocal::link::{LinkError, ReplayLink};
-use stereocal_wire::{Camera, PacketKind};
+use stereocal_wire::{Camera, LogRepr, PacketKind, PacketRepr, Source};
 
 const T: Duration = Duration::from_secs(1);
 
@@ -135,7 +135,7 @@ fn sequence_gap_drops_the_frame_and_the_next_one_is_delivered() {
     let mut wire = Wire::new();
     let spec = FrameSpec::small(1, Camera::Left);
     // Lose the third packet (a Sobel row).
-    let lost_seq = wire.next_seq() + 2;
+    let lost_seq = wire.next_seq(Source::Left) + 2;
     wire.frame_losing(&spec, &[2]);
     wire.frame(&FrameSpec::small(1, Camera::Right));
     let mut d = driver(&wire);
@@ -144,6 +144,7 @@ fn sequence_gap_drops_the_frame_and_the_next_one_is_delivered() {
     assert_eq!(
         damage(first),
         Damage::SequenceGap {
+            sender: Source::Left,
             expected: lost_seq,
             got: lost_seq + 1,
             kind: PacketKind::SobelRows
@@ -220,7 +221,7 @@ fn frame_cut_short_by_the_next_frame_start_is_damaged() {
     for p in &packets[..packets.len() - 1] {
         wire.push(&p.repr());
     }
-    let next_seq = wire.next_seq();
+    let next_seq = wire.next_seq(Source::Left);
     wire.frame(&FrameSpec::small(3, Camera::Left));
     let mut d = driver(&wire);
     let first = d.next_frame(T).unwrap();
@@ -277,9 +278,10 @@ fn log_packets_inside_a_frame_are_surfaced_not_damage() {
     );
     let logs = d.take_logs();
     assert_eq!(logs.len(), 1);
+    // The first packet of the device's control source, whatever the channel sent before.
     assert_eq!(
         (logs[0].seq, &logs[0].bytes[..]),
-        (2, &[0x01, 0x00, 0x2a, 0x00][..])
+        (0, &[0x01, 0x00, 0x2a, 0x00][..])
     );
     assert!(d.take_logs().is_empty());
     assert_eq!(d.stats().log_frames, 1);
@@ -387,6 +389,33 @@ fn pairs_keep_a_damaged_partner_and_split_lone_frames() {
     assert_eq!(bytes, l.wire_bytes + r.wire_bytes);
 }
 
+/// Each source is numbered on its own: a lost control packet is a gap in control's
+/// numbering, which leaves the open camera frame whole; the right channel's numbering does not
+/// continue the left one's.
+#[test]
+fn a_gap_in_another_source_leaves_the_frame_whole() {
+    let mut wire = Wire::new();
+    let packets = frame_packets(&FrameSpec::small(12, Camera::Left));
+    for (i, p) in packets.iter().enumerate() {
+        wire.push(&p.repr());
+        if i == 1 {
+            wire.log(&[1, 2]);
+            wire.lose(&PacketRepr::Log(LogRepr { frame: &[3, 4] }));
+            wire.log(&[5, 6]);
+        }
+    }
+    wire.frame(&FrameSpec::small(12, Camera::Right));
+    assert_eq!(wire.next_seq(Source::Right), wire.next_seq(Source::Left));
+    let mut d = driver(&wire);
+    assert_eq!(delivered(d.next_frame(T).unwrap()).camera, Camera::Left);
+    assert_eq!(delivered(d.next_frame(T).unwrap()).camera, Camera::Right);
+    let s = d.stats();
+    assert_eq!(
+        (s.sequence_gaps, s.packets_lost, s.frames_damaged),
+        (1, 1, 0)
+    );
+}
+
 #[test]
 fn packets_of_an_unknown_kind_are_counted_not_damage() {
     let mut wire = Wire::new();
@@ -394,7 +423,8 @@ fn packets_of_an_unknown_kind_are_counted_not_damage() {
     for (i, p) in packets.iter().enumerate() {
         wire.push(&p.repr());
         if i == 2 {
-            wire.unknown_kind(0x30, &[1, 0, 2, 3]);
+            // A newer channel's kind: the header says it took the channel's next number.
+            wire.unknown_kind(Source::Left, 0x30, &[1, 0, 2, 3]);
         }
     }
     let mut d = driver(&wire);

@@ -12,7 +12,7 @@ use std::time::Instant;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use stereocal_wire::{
     crc32c, decode, encode, max_frame_len, Camera, PacketRepr, Records, SobelPixel, SobelRowsRepr,
-    MAX_SOBEL_ROW_WIDTH,
+    Source, MAX_SOBEL_ROW_WIDTH,
 };
 
 const WIDTH: usize = 1264;
@@ -58,7 +58,7 @@ fn frames(rows: &[Vec<SobelPixel>]) -> Vec<Vec<u8>> {
     rows.iter()
         .enumerate()
         .map(|(y, pixels)| {
-            encode(y as u16, &repr(y, pixels), &mut buf)
+            encode(Source::Left, y as u16, &repr(y, pixels), &mut buf)
                 .unwrap()
                 .to_vec()
         })
@@ -68,7 +68,11 @@ fn frames(rows: &[Vec<SobelPixel>]) -> Vec<Vec<u8>> {
 fn encode_all(rows: &[Vec<SobelPixel>], buf: &mut [u8]) -> usize {
     rows.iter()
         .enumerate()
-        .map(|(y, pixels)| encode(y as u16, &repr(y, pixels), buf).unwrap().len())
+        .map(|(y, pixels)| {
+            encode(Source::Left, y as u16, &repr(y, pixels), buf)
+                .unwrap()
+                .len()
+        })
         .sum()
 }
 

@@ -3,7 +3,7 @@
 use heapless::Vec;
 
 use crate::cobs_in_place::first_zero;
-use crate::frame::{decode_zero_free, DELIMITER};
+use crate::frame::{decode_zero_free, Rejected, DELIMITER};
 use crate::packet::header::Header;
 use crate::packet_repr::PacketRepr;
 use crate::Error;
@@ -43,6 +43,10 @@ pub enum FeedResult<'de, 'a> {
     DecodeError {
         /// What was wrong with the frame.
         error: Error,
+        /// The packet's header, when the packet was intact up to its payload (its kind is
+        /// unknown, or its payload breaks the kind's layout): the packet used up a number of
+        /// its source, which a receiver checking the numbering allows for.
+        header: Option<Header>,
         /// Input after the bad frame's delimiter.
         remaining: &'a [u8],
     },
@@ -120,8 +124,9 @@ impl<const N: usize> Accumulator<N> {
                     packet,
                     remaining: rest,
                 },
-                Err(error) => FeedResult::DecodeError {
+                Err(Rejected { error, header }) => FeedResult::DecodeError {
                     error,
+                    header,
                     remaining: rest,
                 },
             };

@@ -6,6 +6,7 @@
 
 use crate::cobs_in_place;
 use crate::packet::header::{self, Header, CRC_LEN, HEADER_LEN};
+use crate::packet::source::Source;
 use crate::packet_repr::PacketRepr;
 use crate::{Error, MAX_PAYLOAD_LEN, PROTOCOL_VERSION, SUPPORTED_VERSIONS};
 
@@ -18,7 +19,7 @@ pub const fn max_frame_len(payload_len: usize) -> usize {
     cobs::max_encoding_length(HEADER_LEN + payload_len + CRC_LEN) + 1
 }
 
-/// Encodes `repr` with sequence number `seq` into `out` as one complete frame, delimiter
+/// Encodes `repr` as packet `seq` of `source` into `out` as one complete frame, delimiter
 /// included, and returns the frame (a prefix of `out`).
 ///
 /// `out` must hold [`max_frame_len`]`(repr.buffer_len())` bytes (at most
@@ -27,7 +28,12 @@ pub const fn max_frame_len(payload_len: usize) -> usize {
 /// COBS-encoded in place, so no second buffer is needed on the soft-core. Mostly that only
 /// rewrites its zeros; a packet with full COBS blocks (254 non-zero bytes) first moves one
 /// byte towards the end per such block, into the room the length check kept.
-pub fn encode<'o>(seq: u16, repr: &PacketRepr<'_>, out: &'o mut [u8]) -> Result<&'o [u8], Error> {
+pub fn encode<'o>(
+    source: Source,
+    seq: u16,
+    repr: &PacketRepr<'_>,
+    out: &'o mut [u8],
+) -> Result<&'o [u8], Error> {
     let payload_len = repr.buffer_len();
     if payload_len > MAX_PAYLOAD_LEN {
         return Err(Error::EncodeTooManyRecords);
@@ -44,6 +50,7 @@ pub fn encode<'o>(seq: u16, repr: &PacketRepr<'_>, out: &'o mut [u8]) -> Result<
     let header = Header {
         version: PROTOCOL_VERSION,
         kind: repr.kind(),
+        source,
         seq,
         // `payload_len <= MAX_PAYLOAD_LEN`, which fits a u16 (asserted in lib.rs).
         payload_len: payload_len as u16,
@@ -77,33 +84,54 @@ pub fn decode(frame: &mut [u8]) -> Result<(Header, PacketRepr<'_>), Error> {
     if encoded.contains(&DELIMITER) {
         return Err(Error::DecodeBadCobs);
     }
-    decode_zero_free(encoded)
+    decode_zero_free(encoded).map_err(|rejected| rejected.error)
+}
+
+/// Why a frame did not decode, with its header when the packet was intact up to its payload
+/// (a kind this crate does not know, a payload that breaks its kind's layout): the packet
+/// still used up a number of its source.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Rejected {
+    pub error: Error,
+    pub header: Option<Header>,
+}
+
+impl From<Error> for Rejected {
+    fn from(error: Error) -> Self {
+        Rejected {
+            error,
+            header: None,
+        }
+    }
 }
 
 /// [`decode`] of COBS bytes known to hold no `0x00` (the [`Accumulator`](crate::Accumulator)
 /// cuts its frames at the zeros, so it need not scan them again).
-pub(crate) fn decode_zero_free(encoded: &mut [u8]) -> Result<(Header, PacketRepr<'_>), Error> {
+pub(crate) fn decode_zero_free(encoded: &mut [u8]) -> Result<(Header, PacketRepr<'_>), Rejected> {
     let packet = cobs_in_place::decode_in_place(encoded).ok_or(Error::DecodeBadCobs)?;
     let encoded: &[u8] = encoded;
     parse_packet(encoded.get(packet).ok_or(Error::DecodeBadCobs)?)
 }
 
 /// Checks and parses the bytes of a whole packet (after COBS decoding).
-fn parse_packet(bytes: &[u8]) -> Result<(Header, PacketRepr<'_>), Error> {
+fn parse_packet(bytes: &[u8]) -> Result<(Header, PacketRepr<'_>), Rejected> {
     if bytes.len() < HEADER_LEN + CRC_LEN {
-        return Err(Error::DecodeUnexpectedEnd);
+        return Err(Error::DecodeUnexpectedEnd.into());
     }
     let packet = header::Packet::new_unchecked(bytes);
     if !cfg!(fuzzing) && !packet.verify_crc() {
-        return Err(Error::DecodeBadCrc);
+        return Err(Error::DecodeBadCrc.into());
     }
     if !SUPPORTED_VERSIONS.contains(&packet.version()) {
-        return Err(Error::DecodeUnknownVersion);
+        return Err(Error::DecodeUnknownVersion.into());
     }
     let header = Header::parse(&packet)?;
     let payload = bytes
         .get(HEADER_LEN..bytes.len() - CRC_LEN)
         .ok_or(Error::DecodeUnexpectedEnd)?;
-    let repr = PacketRepr::parse(header.kind, payload)?;
+    let repr = PacketRepr::parse(header.kind, payload).map_err(|error| Rejected {
+        error,
+        header: Some(header),
+    })?;
     Ok((header, repr))
 }

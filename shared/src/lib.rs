@@ -7,7 +7,7 @@
 //! Build a [`PacketRepr`] and [`encode`] it into a buffer you own; the result is one complete
 //! frame, delimiter included, ready for the UART:
 //! ```
-//! use stereocal_wire::{encode, Camera, FrameStartRepr, PacketRepr, MAX_FRAME_LEN};
+//! use stereocal_wire::{encode, Camera, FrameStartRepr, PacketRepr, Source, MAX_FRAME_LEN};
 //!
 //! let mut buf = [0u8; MAX_FRAME_LEN];
 //! let repr = PacketRepr::FrameStart(FrameStartRepr {
@@ -18,7 +18,8 @@
 //!     octaves: 4,
 //!     timestamp_us: 0,
 //! });
-//! let frame: &[u8] = encode(0, &repr, &mut buf)?;
+//! // The left camera's channel numbers its own packets; this is its first.
+//! let frame: &[u8] = encode(Source::channel(Camera::Left), 0, &repr, &mut buf)?;
 //! assert_eq!(frame.last(), Some(&0x00));
 //! # Ok::<(), stereocal_wire::Error>(())
 //! ```
@@ -37,13 +38,13 @@
 //!     window = match acc.feed(window) {
 //!         FeedResult::Consumed => break,
 //!         FeedResult::OverFull(rest) => rest,
-//!         FeedResult::DecodeError { error, remaining } => {
+//!         FeedResult::DecodeError { error, remaining, .. } => {
 //!             // count `error`; the next frame decodes normally
 //!             remaining
 //!         }
 //!         FeedResult::Success { header, packet, remaining } => {
 //!             // `packet` borrows the accumulator until the next `feed`
-//!             let _ = (header.seq, packet.kind());
+//!             let _ = (header.source, header.seq, packet.kind());
 //!             remaining
 //!         }
 //!     };
@@ -65,6 +66,7 @@ mod checksum;
 mod cobs_in_place;
 mod error;
 mod frame;
+mod geometry;
 mod le;
 mod packet_repr;
 mod records;
@@ -73,10 +75,12 @@ pub use accumulator::{Accumulator, FeedResult};
 pub use checksum::crc32c;
 pub use error::Error;
 pub use frame::{decode, encode, max_frame_len, DELIMITER};
+pub use geometry::octave_dims;
 pub use packet::camera::Camera;
 pub use packet::encoders::EncodersRepr;
 pub use packet::error_report::{ErrorCode, ErrorReportRepr};
 pub use packet::frame_end::{FrameEndFlags, FrameEndRepr};
+pub use packet::frame_failure::{FrameFailure, MAX_FAILURE_VALUE};
 pub use packet::frame_start::FrameStartRepr;
 pub use packet::header::{Header, CRC_LEN, HEADER_LEN};
 pub use packet::hello::{Capabilities, HelloRepr};
@@ -89,12 +93,14 @@ pub use packet::register_write::RegisterWriteRepr;
 pub use packet::sobel_patch::{SobelPatchRepr, PATCH_PIXELS, PATCH_SIZE};
 pub use packet::sobel_pixel::{SobelPixel, ORIENTATION_BITS};
 pub use packet::sobel_rows::{SobelRowsRepr, MAX_WIDTH as MAX_SOBEL_ROW_WIDTH};
+pub use packet::source::Source;
 pub use packet_repr::PacketRepr;
 pub use records::{Record, RecordIter, Records};
 
-/// The protocol version this crate writes.
-pub const PROTOCOL_VERSION: u8 = 1;
+/// The protocol version this crate writes: 2, whose header names the packet's source.
+pub const PROTOCOL_VERSION: u8 = 2;
 /// The protocol versions [`decode`] accepts; any other is [`Error::DecodeUnknownVersion`].
+/// Version 1's header has no source byte, so its fields sit elsewhere: it is not read.
 pub const SUPPORTED_VERSIONS: &[u8] = &[PROTOCOL_VERSION];
 
 /// Payload length of `Hello`.

@@ -7,13 +7,13 @@ use arbitrary::{packet, OwnedPacket};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use stereocal_wire::{
-    crc32c, decode, encode, Accumulator, Error, FeedResult, HelloRepr, PacketRepr,
-    RegisterReadRepr, CRC_LEN, MAX_FRAME_LEN,
+    crc32c, decode, encode, Accumulator, Error, FeedResult, Header, HelloRepr, PacketKind,
+    PacketRepr, RegisterReadRepr, Source, CRC_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 
 fn encoded(seq: u16, packet: &PacketRepr<'_>) -> Vec<u8> {
     let mut buf = [0u8; MAX_FRAME_LEN];
-    encode(seq, packet, &mut buf)
+    encode(Source::Control, seq, packet, &mut buf)
         .expect("valid packets encode")
         .to_vec()
 }
@@ -51,7 +51,9 @@ fn run<const N: usize>(stream: &[u8]) -> Outcome {
                 outcome.overfull += 1;
                 rest
             }
-            FeedResult::DecodeError { error, remaining } => {
+            FeedResult::DecodeError {
+                error, remaining, ..
+            } => {
                 outcome.errors.push(error);
                 remaining
             }
@@ -160,7 +162,7 @@ proptest! {
         len_field in any::<u16>(),
         payload in vec(any::<u8>(), 0..3000),
     ) {
-        let mut raw = vec![1, kind, 0, 0];
+        let mut raw = vec![PROTOCOL_VERSION, kind, 0, 0, 0];
         raw.extend_from_slice(&len_field.to_le_bytes());
         raw.extend_from_slice(&payload);
         let _ = decode(&mut frame_around(&raw));
@@ -169,17 +171,22 @@ proptest! {
 
 #[test]
 fn each_failure_has_its_error() {
-    let good = [1u8, 0x03, 0x07, 0x00, 0x02, 0x00, 0x34, 0x12];
+    let good = [2u8, 0x03, 0x01, 0x07, 0x00, 0x02, 0x00, 0x34, 0x12];
     let mut frame = frame_around(&good);
     let (header, repr) = decode(&mut frame).unwrap();
-    assert_eq!((header.seq, repr), (7, marker(0x1234)));
-
-    let mut bad_version = good;
-    bad_version[0] = 2;
     assert_eq!(
-        decode(&mut frame_around(&bad_version)).unwrap_err(),
-        Error::DecodeUnknownVersion
+        (header.source, header.seq, repr),
+        (Source::Left, 7, marker(0x1234))
     );
+
+    for version in [0, 1, 3] {
+        let mut bad_version = good;
+        bad_version[0] = version;
+        assert_eq!(
+            decode(&mut frame_around(&bad_version)).unwrap_err(),
+            Error::DecodeUnknownVersion
+        );
+    }
 
     let mut bad_kind = good;
     bad_kind[1] = 0x7f;
@@ -189,21 +196,21 @@ fn each_failure_has_its_error() {
     );
 
     let mut long_field = good;
-    long_field[4] = 3;
+    long_field[5] = 3;
     assert_eq!(
         decode(&mut frame_around(&long_field)).unwrap_err(),
         Error::DecodeUnexpectedEnd
     );
 
     let mut short_field = good;
-    short_field[4] = 1;
+    short_field[5] = 1;
     assert_eq!(
         decode(&mut frame_around(&short_field)).unwrap_err(),
         Error::DecodeBadLength
     );
 
     let mut extra_payload = good.to_vec();
-    extra_payload[4] = 3;
+    extra_payload[5] = 3;
     extra_payload.push(0x55);
     assert_eq!(
         decode(&mut frame_around(&extra_payload)).unwrap_err(),
@@ -216,7 +223,7 @@ fn each_failure_has_its_error() {
     assert_eq!(decode(&mut bad_crc).unwrap_err(), Error::DecodeBadCrc);
 
     assert_eq!(
-        decode(&mut frame_around(&good[..5])).unwrap_err(),
+        decode(&mut frame_around(&good[..6])).unwrap_err(),
         Error::DecodeUnexpectedEnd
     );
     assert_eq!(decode(&mut []).unwrap_err(), Error::DecodeUnexpectedEnd);
@@ -230,6 +237,56 @@ fn each_failure_has_its_error() {
     assert_eq!(
         decode(&mut [0x02, 0x01, 0x00, 0x02, 0x01]).unwrap_err(),
         Error::DecodeBadCobs
+    );
+}
+
+/// An intact packet whose kind or payload the receiver cannot read still says who sent it
+/// and its number, so the receiver's numbering of that source goes on without a gap; a
+/// damaged packet says nothing.
+#[test]
+fn an_intact_header_comes_with_the_error() {
+    let unknown_kind = [2u8, 0x7f, 0x02, 0x09, 0x00, 0x00, 0x00];
+    let bad_payload = [2u8, 0x03, 0x01, 0x0a, 0x00, 0x01, 0x00, 0x34];
+    let mut damaged = frame_around(&unknown_kind);
+    damaged[3] ^= 0x01;
+    let stream = [
+        frame_around(&unknown_kind),
+        frame_around(&bad_payload),
+        damaged,
+    ]
+    .concat();
+    let mut acc = Accumulator::<MAX_FRAME_LEN>::new();
+    let mut window = &stream[..];
+    let mut seen = Vec::new();
+    while let FeedResult::DecodeError {
+        error,
+        header,
+        remaining,
+    } = acc.feed(window)
+    {
+        seen.push((error, header));
+        window = remaining;
+    }
+    let header = |kind, source, seq, payload_len| Header {
+        version: 2,
+        kind,
+        source,
+        seq,
+        payload_len,
+    };
+    assert_eq!(
+        seen,
+        [
+            (
+                Error::DecodeUnknownKind,
+                Some(header(PacketKind::Unknown(0x7f), Source::Right, 9, 0))
+            ),
+            (
+                Error::DecodeUnexpectedEnd,
+                Some(header(PacketKind::RegisterRead, Source::Left, 10, 1))
+            ),
+            (Error::DecodeBadCrc, None),
+        ]
     );
 }
 

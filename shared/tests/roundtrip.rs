@@ -7,13 +7,13 @@ use arbitrary::{packet, OwnedPacket};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use stereocal_wire::{
-    decode, encode, max_frame_len, Accumulator, FeedResult, PacketRepr, CRC_LEN, HEADER_LEN,
-    MAX_FRAME_LEN, PROTOCOL_VERSION,
+    decode, encode, max_frame_len, Accumulator, FeedResult, PacketRepr, Source, CRC_LEN,
+    HEADER_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 
-fn encoded(seq: u16, packet: &OwnedPacket) -> Vec<u8> {
+fn encoded(source: Source, seq: u16, packet: &OwnedPacket) -> Vec<u8> {
     let mut buf = [0u8; MAX_FRAME_LEN];
-    encode(seq, &packet.repr(), &mut buf)
+    encode(source, seq, &packet.repr(), &mut buf)
         .expect("valid packets encode")
         .to_vec()
 }
@@ -22,15 +22,17 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(512))]
 
     #[test]
-    fn decode_inverts_encode(seq in any::<u16>(), packet in packet()) {
+    fn decode_inverts_encode(source in any::<u8>(), seq in any::<u16>(), packet in packet()) {
         let repr = packet.repr();
-        let mut frame = encoded(seq, &packet);
+        let source = Source::from(source);
+        let mut frame = encoded(source, seq, &packet);
         prop_assert!(frame.len() <= max_frame_len(repr.buffer_len()));
         prop_assert_eq!(frame.last(), Some(&0));
         prop_assert!(!frame[..frame.len() - 1].contains(&0));
 
         let (header, decoded) = decode(&mut frame).expect("own frames decode");
         prop_assert_eq!(header.version, PROTOCOL_VERSION);
+        prop_assert_eq!(header.source, source);
         prop_assert_eq!(header.seq, seq);
         prop_assert_eq!(header.kind, repr.kind());
         prop_assert_eq!(usize::from(header.payload_len), repr.buffer_len());
@@ -39,7 +41,7 @@ proptest! {
 
     #[test]
     fn in_place_cobs_matches_the_cobs_crate(seq in any::<u16>(), packet in packet()) {
-        let frame = encoded(seq, &packet);
+        let frame = encoded(Source::Left, seq, &packet);
         let body = &frame[..frame.len() - 1];
         let mut raw = vec![0u8; body.len()];
         let raw_len = cobs::decode(body, &mut raw).expect("valid COBS").frame_size();
@@ -55,7 +57,7 @@ proptest! {
         chunk_sizes in vec(1usize..700, 1..64),
     ) {
         let stream: Vec<u8> =
-            packets.iter().enumerate().flat_map(|(seq, p)| encoded(seq as u16, p)).collect();
+            packets.iter().enumerate().flat_map(|(seq, p)| encoded(Source::Right, seq as u16, p)).collect();
         let mut acc = Accumulator::<MAX_FRAME_LEN>::new();
         let mut received = 0usize;
         let mut offset = 0;
@@ -87,11 +89,11 @@ fn short_output_buffer_is_an_error() {
     let needed = max_frame_len(repr.buffer_len());
     let mut buf = vec![0u8; needed - 1];
     assert_eq!(
-        encode(0, &repr, &mut buf),
+        encode(Source::Control, 0, &repr, &mut buf),
         Err(stereocal_wire::Error::EncodeBufferTooSmall)
     );
     let mut buf = vec![0u8; needed];
-    assert!(encode(0, &repr, &mut buf).is_ok());
+    assert!(encode(Source::Control, 0, &repr, &mut buf).is_ok());
 }
 
 #[test]
@@ -111,7 +113,7 @@ fn max_frame_len_covers_the_largest_packet() {
     });
     assert_eq!(repr.buffer_len(), stereocal_wire::MAX_PAYLOAD_LEN);
     let mut buf = [0u8; MAX_FRAME_LEN];
-    let frame = encode(0xffff, &repr, &mut buf).unwrap();
+    let frame = encode(Source::Unknown(0xff), 0xffff, &repr, &mut buf).unwrap();
     assert!(frame.len() <= MAX_FRAME_LEN);
     let mut frame = frame.to_vec();
     assert_eq!(decode(&mut frame).unwrap().1, repr);
@@ -140,7 +142,9 @@ fn long_nonzero_runs_encode_like_the_cobs_crate() {
         });
         for repr in [log, rows] {
             let mut buf = [0u8; MAX_FRAME_LEN];
-            let mut frame = encode(0xffff, &repr, &mut buf).unwrap().to_vec();
+            let mut frame = encode(Source::Unknown(0xff), 0xffff, &repr, &mut buf)
+                .unwrap()
+                .to_vec();
             let body = &frame[..frame.len() - 1];
             let mut raw = vec![0u8; body.len()];
             let raw_len = cobs::decode(body, &mut raw).unwrap().frame_size();

@@ -20,7 +20,7 @@ use stereocal_wire::{
     decode, encode, Camera, Capabilities, EncodersRepr, ErrorCode, ErrorReportRepr, FrameEndFlags,
     FrameEndRepr, FrameStartRepr, HelloRepr, LogRepr, PacketRepr, Point, PointBatchRepr, Records,
     RegisterReadRepr, RegisterValueRepr, RegisterWriteRepr, SobelPatchRepr, SobelPixel,
-    SobelRowsRepr, MAX_FRAME_LEN, PATCH_PIXELS,
+    SobelRowsRepr, Source, MAX_FRAME_LEN, PATCH_PIXELS,
 };
 
 const SPEC: &str = include_str!("../docs/wire-format.md");
@@ -75,15 +75,16 @@ fn patch() -> [SobelPixel; PATCH_PIXELS] {
     })
 }
 
-/// Every vector: name → (sequence number, packet).
-fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)> {
+/// Every vector: name → (source, sequence number, packet).
+fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (Source, u16, PacketRepr<'_>)> {
     BTreeMap::from([
         (
             "hello",
             (
+                Source::Control,
                 0x0001,
                 PacketRepr::Hello(HelloRepr {
-                    version: 1,
+                    version: 2,
                     capabilities: Capabilities::POINTS
                         | Capabilities::SOBEL_PATCHES
                         | Capabilities::LOG
@@ -94,6 +95,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "register_write",
             (
+                Source::Control,
                 0x0002,
                 PacketRepr::RegisterWrite(RegisterWriteRepr {
                     addr: 0x0104,
@@ -104,6 +106,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "register_read",
             (
+                Source::Control,
                 0x0003,
                 PacketRepr::RegisterRead(RegisterReadRepr { addr: 0x0104 }),
             ),
@@ -111,7 +114,8 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "register_value",
             (
-                0x0003,
+                Source::Control,
+                0x0001,
                 PacketRepr::RegisterValue(RegisterValueRepr {
                     addr: 0x0104,
                     value: 0x0000_0020,
@@ -121,6 +125,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "frame_start",
             (
+                Source::Right,
                 0x0100,
                 PacketRepr::FrameStart(FrameStartRepr {
                     frame_id: 42,
@@ -135,6 +140,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "point_batch",
             (
+                Source::Right,
                 0x0101,
                 PacketRepr::PointBatch(PointBatchRepr {
                     frame_id: 42,
@@ -146,7 +152,8 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "sobel_rows",
             (
-                0x0102,
+                Source::Left,
+                0x0201,
                 PacketRepr::SobelRows(SobelRowsRepr {
                     frame_id: 42,
                     camera: Camera::Left,
@@ -160,6 +167,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "sobel_patch",
             (
+                Source::Right,
                 0x0103,
                 PacketRepr::SobelPatch(SobelPatchRepr {
                     frame_id: 42,
@@ -176,6 +184,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "frame_end",
             (
+                Source::Right,
                 0x0104,
                 PacketRepr::FrameEnd(FrameEndRepr {
                     frame_id: 42,
@@ -191,7 +200,8 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "encoders",
             (
-                0x0107,
+                Source::Control,
+                0x0002,
                 PacketRepr::Encoders(EncodersRepr {
                     frame_id: 42,
                     left_yaw_udeg: 7_500_000,
@@ -202,7 +212,8 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "log",
             (
-                0x0105,
+                Source::Control,
+                0x0003,
                 PacketRepr::Log(LogRepr {
                     frame: &[0x01, 0x00, 0x2a, 0x00],
                 }),
@@ -211,7 +222,8 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "error_report",
             (
-                0x0106,
+                Source::Control,
+                0x0004,
                 PacketRepr::ErrorReport(ErrorReportRepr {
                     code: ErrorCode::UnknownRegister,
                     detail: 0x9000,
@@ -221,6 +233,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (u16, PacketRepr<'_>)
         (
             "camera_unknown",
             (
+                Source::Unknown(0x08),
                 0xffff,
                 PacketRepr::FrameStart(FrameStartRepr {
                     frame_id: u32::MAX,
@@ -296,9 +309,9 @@ fn render(name: &str, block: &Block) -> String {
     text + "```\n"
 }
 
-fn encoded(seq: u16, repr: &PacketRepr<'_>) -> Block {
+fn encoded(source: Source, seq: u16, repr: &PacketRepr<'_>) -> Block {
     let mut buf = [0u8; MAX_FRAME_LEN];
-    let frame = encode(seq, repr, &mut buf)
+    let frame = encode(source, seq, repr, &mut buf)
         .expect("vector encodes")
         .to_vec();
     let mut packet = vec![0u8; frame.len()];
@@ -315,13 +328,17 @@ fn spec_vectors_match_the_code() {
     let vectors = vectors(&patch);
     let blocks = spec_blocks();
     let mut report = String::new();
-    for (name, (seq, repr)) in &vectors {
-        let expected = encoded(*seq, repr);
+    for (name, (source, seq, repr)) in &vectors {
+        let expected = encoded(*source, *seq, repr);
         match blocks.get(*name) {
             Some(block) if *block == expected => {
                 let mut frame = block.frame.clone();
                 let (header, decoded) = decode(&mut frame).expect("spec frame decodes");
-                assert_eq!(header.seq, *seq, "vector {name}");
+                assert_eq!(
+                    (header.source, header.seq),
+                    (*source, *seq),
+                    "vector {name}"
+                );
                 assert_eq!(&decoded, repr, "vector {name}");
             }
             _ => report += &render(name, &expected),
@@ -347,8 +364,8 @@ fn fuzz_corpus_holds_the_vector_frames() {
     let mut stale = Vec::new();
     let mut seeds: Vec<(String, Vec<u8>)> = vectors(&patch)
         .iter()
-        .map(|(name, (seq, repr))| {
-            let frame = encoded(*seq, repr).frame;
+        .map(|(name, (source, seq, repr))| {
+            let frame = encoded(*source, *seq, repr).frame;
             all.extend_from_slice(&frame);
             (format!("vector-{name}"), frame)
         })

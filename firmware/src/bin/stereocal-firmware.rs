@@ -106,10 +106,7 @@ mod soft_core {
             .and_then(|()| bus.write_field(&height::VALUE, header.height.into()));
         if let Err(e) = geometry {
             defmt::error!("input frames: {}", defmt::Display2Format(&e));
-            report(
-                ErrorCode::Unknown(stereocal_firmware::driver::ERROR_INVALID_CONFIG),
-                width::OFFSET.into(),
-            );
+            report(ErrorCode::InvalidConfig, width::OFFSET.into());
             stop(ExitCode::BadInput);
         }
         if header.has_flag(FLAG_AUTOSTART) {

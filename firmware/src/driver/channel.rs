@@ -5,11 +5,12 @@ use stereocal_hdl::{register_at, FabricConfig, PixelIn, RegisterBus, Registers};
 use stereocal_wire::{
     Camera, Capabilities, ErrorCode, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr,
     HelloRepr, PacketRepr, PointBatchRepr, Records, RegisterValueRepr, SobelPatchRepr, SobelPixel,
-    SobelRowsRepr, PATCH_PIXELS, PROTOCOL_VERSION,
+    SobelRowsRepr, Source, PATCH_PIXELS, PROTOCOL_VERSION,
 };
 
-use crate::driver::error::{DriverError, ERROR_UNEXPECTED_KIND};
+use crate::driver::error::DriverError;
 use crate::driver::fifo_reader::FifoReader;
+use crate::driver::numbering::Numbering;
 use crate::driver::patch::{PatchQueue, PendingPatch, HALF};
 use crate::driver::point_batch::{wire_point, PointBatch};
 use crate::driver::sink::{ByteSink, PacketWriter};
@@ -71,6 +72,8 @@ pub struct Driver<B: RegisterBus + PixelIn, const W0: usize = 1280> {
 /// into packets. Kept apart so a drain can hand it the entries it pops.
 struct FrameOutput<const W0: usize> {
     camera: Camera,
+    /// The channel's source (its camera's) and its packets' numbers.
+    numbering: Numbering,
     frame: FrameState,
     ring: SobelRing<W0>,
     patches: PatchQueue,
@@ -89,6 +92,7 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
             reader: FifoReader::new(),
             output: FrameOutput {
                 camera,
+                numbering: Numbering::new(Source::channel(camera)),
                 frame: FrameState {
                     id: 0,
                     mode: SobelOutput::Patches,
@@ -114,6 +118,11 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
     /// The camera this channel serves.
     pub fn camera(&self) -> Camera {
         self.output.camera
+    }
+
+    /// The channel's source and the number its next packet will carry.
+    pub fn numbering(&self) -> &Numbering {
+        &self.output.numbering
     }
 
     /// The number the next frame will get.
@@ -148,7 +157,7 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
         mapped
     }
 
-    /// Answers a packet from the host: `Hello` with `Hello`, `RegisterRead` with
+    /// Answers a packet from the host, from the device's control source: `Hello` with `Hello`, `RegisterRead` with
     /// `RegisterValue`, `RegisterWrite` silently; an unknown register address with
     /// `ErrorReport(UnknownRegister)`, a device-to-host kind with an `ErrorReport` naming the
     /// kind. An `ErrorReport` from the host needs no answer.
@@ -177,11 +186,11 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
             PacketRepr::RegisterRead(r) => unknown_register(r.addr),
             PacketRepr::ErrorReport(_) => return Ok(()),
             ref other => PacketRepr::ErrorReport(ErrorReportRepr {
-                code: ErrorCode::Unknown(ERROR_UNEXPECTED_KIND),
+                code: ErrorCode::UnexpectedKind,
                 detail: u32::from(u8::from(other.kind())),
             }),
         };
-        send(out, &answer)
+        out.send(&answer).map_err(DriverError::Encode)
     }
 
     /// Runs one `width * height` image (raster order, 8-bit grey) through the fabric with the
@@ -256,6 +265,7 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
 
         send(
             out,
+            &mut self.output.numbering,
             &PacketRepr::FrameStart(FrameStartRepr {
                 frame_id: self.output.frame.id,
                 camera: self.output.camera,
@@ -304,6 +314,7 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
         }
         send(
             out,
+            &mut self.output.numbering,
             &PacketRepr::FrameEnd(FrameEndRepr {
                 frame_id: self.output.frame.id,
                 camera: self.output.camera,
@@ -451,6 +462,7 @@ impl<const W0: usize> FrameOutput<W0> {
                     };
                     send(
                         out,
+                        &mut self.numbering,
                         &PacketRepr::SobelRows(SobelRowsRepr {
                             frame_id: self.frame.id,
                             camera: self.camera,
@@ -500,6 +512,7 @@ impl<const W0: usize> FrameOutput<W0> {
         );
         send(
             out,
+            &mut self.numbering,
             &PacketRepr::SobelPatch(SobelPatchRepr {
                 frame_id: self.frame.id,
                 camera: self.camera,
@@ -522,6 +535,7 @@ impl<const W0: usize> FrameOutput<W0> {
         }
         send(
             out,
+            &mut self.numbering,
             &PacketRepr::PointBatch(PointBatchRepr {
                 frame_id: self.frame.id,
                 camera: self.camera,
@@ -556,9 +570,12 @@ fn unknown_register(addr: u16) -> PacketRepr<'static> {
     })
 }
 
+/// Sends one of the channel's packets, as its source.
 fn send<S: ByteSink>(
     out: &mut PacketWriter<S>,
+    numbering: &mut Numbering,
     packet: &PacketRepr<'_>,
 ) -> Result<(), DriverError> {
-    out.send(packet).map_err(DriverError::Encode)
+    out.send_from(numbering, packet)
+        .map_err(DriverError::Encode)
 }

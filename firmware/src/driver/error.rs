@@ -3,21 +3,10 @@
 use core::fmt;
 
 use stereocal_hdl::regs;
-use stereocal_wire::ErrorCode;
+use stereocal_wire::{ErrorCode, FrameFailure};
 
 use crate::driver::sobel_ring::OutOfOrder;
 use crate::fabric::{ConfigError, FrameError};
-
-/// `ErrorReport` code: the fabric's registers hold a configuration it cannot run; `detail` is
-/// the byte offset of the register at fault. (Not yet in the wire spec's table; sent as
-/// `ErrorCode::Unknown(0x0100)`.)
-pub const ERROR_INVALID_CONFIG: u16 = 0x0100;
-/// `ErrorReport` code: the host sent a packet kind only the device sends; `detail` is the kind
-/// byte. (Not yet in the wire spec's table.)
-pub const ERROR_UNEXPECTED_KIND: u16 = 0x0101;
-/// `ErrorReport` code: a frame could not be processed (wrong image size, or a fabric model
-/// defect); `detail` is [`DriverError::detail`]. (Not yet in the wire spec's table.)
-pub const ERROR_FRAME_FAILED: u16 = 0x0102;
 
 /// Why the driver could not configure the fabric or process a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,36 +51,41 @@ pub enum DriverError {
 }
 
 impl DriverError {
-    /// The `ErrorReport` code and detail that tell the host about this error.
+    /// The `ErrorReport` code and detail that tell the host about this error: a
+    /// configuration the fabric cannot run names its register (`InvalidConfig`), any other
+    /// failure its cause (`FrameFailed`, detail [`Self::detail`]).
     pub fn report(&self) -> (ErrorCode, u32) {
         match self {
             Self::Registers(e) => (
-                ErrorCode::Unknown(ERROR_INVALID_CONFIG),
+                ErrorCode::InvalidConfig,
                 register_offset(e).map_or(u32::MAX, u32::from),
             ),
-            Self::TooWide { .. } | Self::FabricConfig(_) => (
-                ErrorCode::Unknown(ERROR_INVALID_CONFIG),
-                u32::from(regs::width::OFFSET),
-            ),
-            _ => (ErrorCode::Unknown(ERROR_FRAME_FAILED), self.detail()),
+            Self::TooWide { .. } | Self::FabricConfig(_) => {
+                (ErrorCode::InvalidConfig, u32::from(regs::width::OFFSET))
+            }
+            _ => (ErrorCode::FrameFailed, self.detail()),
         }
     }
 
-    /// A number that tells the variants apart in an `ErrorReport`: the variant index in the
-    /// top byte and a variant-specific value (a size, a coordinate) below.
+    /// The `FrameFailed` detail of this error: its cause and a value that locates it (a size,
+    /// a row), as the wire spec lays them out.
     pub fn detail(&self) -> u32 {
-        let (variant, value): (u32, u32) = match *self {
-            Self::Registers(_) => (1, 0),
-            Self::FabricConfig(_) => (2, 0),
-            Self::Frame(_) => (3, 0),
-            Self::ImageSize { got, .. } => (4, got.min(0xFF_FFFF) as u32),
-            Self::TooWide { width, .. } => (5, u32::from(width)),
-            Self::SobelOutOfOrder(p) => (6, u32::from(p.y)),
-            Self::PointOutOfFrame { y, .. } => (7, u32::from(y)),
-            Self::Encode(_) => (8, 0),
-            Self::NotArmed => (9, 0),
+        let (cause, value) = match *self {
+            Self::Registers(_) => (FrameFailure::Registers, 0),
+            Self::FabricConfig(_) => (FrameFailure::FabricConfig, 0),
+            Self::Frame(_) => (FrameFailure::Frame, 0),
+            // Saturated by `FrameFailure::detail` to the 24 bits the value has.
+            Self::ImageSize { got, .. } => (
+                FrameFailure::ImageSize,
+                u32::try_from(got).unwrap_or(u32::MAX),
+            ),
+            Self::TooWide { width, .. } => (FrameFailure::TooWide, u32::from(width)),
+            Self::SobelOutOfOrder(p) => (FrameFailure::SobelOutOfOrder, u32::from(p.y)),
+            Self::PointOutOfFrame { y, .. } => (FrameFailure::PointOutOfFrame, u32::from(y)),
+            Self::Encode(_) => (FrameFailure::Encode, 0),
+            Self::NotArmed => (FrameFailure::NotArmed, 0),
         };
-        (variant << 24) | value
+        cause.detail(value)
     }
 }
 
@@ -156,10 +150,31 @@ mod tests {
         });
         assert_eq!(
             e.report(),
-            (
-                ErrorCode::Unknown(ERROR_INVALID_CONFIG),
-                u32::from(regs::octaves::OFFSET)
-            )
+            (ErrorCode::InvalidConfig, u32::from(regs::octaves::OFFSET))
+        );
+    }
+
+    #[test]
+    fn frame_failures_name_their_cause() {
+        assert_eq!(
+            DriverError::NotArmed.report(),
+            (ErrorCode::FrameFailed, 0x0900_0000)
+        );
+        let image = DriverError::ImageSize {
+            expected: 64 * 32,
+            got: 100,
+        };
+        assert_eq!(
+            FrameFailure::from_detail(image.report().1),
+            (FrameFailure::ImageSize, 100)
+        );
+        let huge = DriverError::ImageSize {
+            expected: 64 * 32,
+            got: usize::MAX,
+        };
+        assert_eq!(
+            FrameFailure::from_detail(huge.detail()),
+            (FrameFailure::ImageSize, stereocal_wire::MAX_FAILURE_VALUE)
         );
     }
 }

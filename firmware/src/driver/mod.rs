@@ -7,7 +7,8 @@
 //! ([`stereocal_hdl::PixelIn`]), so it is generic over what implements those:
 //! [`stereocal_hdl::Mmio`] on an FPGA, the device model [`crate::fabric::FabricDevice`] in
 //! software (in the soft-core ELF under QEMU and in the host's in-process link). It writes
-//! into any [`ByteSink`] through a [`PacketWriter`] that numbers the packets:
+//! into any [`ByteSink`] through a [`PacketWriter`]; the channel numbers its packets as its
+//! camera's source ([`Numbering`]), the writer the device's control packets:
 //!
 //! ```
 //! use stereocal_firmware::driver::{ByteSink, Driver, PacketWriter};
@@ -58,13 +59,15 @@
 mod channel;
 mod error;
 mod fifo_reader;
+mod numbering;
 mod patch;
 mod point_batch;
 mod sink;
 mod sobel_ring;
 
 pub use channel::{Driver, FrameSummary, CHANNEL_CAPABILITIES};
-pub use error::{DriverError, ERROR_FRAME_FAILED, ERROR_INVALID_CONFIG, ERROR_UNEXPECTED_KIND};
+pub use error::DriverError;
+pub use numbering::Numbering;
 pub use patch::MAX_PENDING;
 pub use sink::{ByteSink, PacketWriter};
 pub use sobel_ring::{OutOfOrder, RING_ROWS};

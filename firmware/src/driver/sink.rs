@@ -1,11 +1,14 @@
-//! Where the driver's packets go: a byte sink, and the writer that numbers and frames packets.
+//! Where the driver's packets go: a byte sink, and the writer that frames packets into it.
 //!
 //! The driver never owns the link. On the soft-core the sink is the UART; in the host's
-//! in-process link it is a `Vec<u8>` or a channel. One [`PacketWriter`] per link keeps one
-//! sequence counter, so the packets of both cameras (and the firmware's log packets) share a
-//! single numbering and the host sees every gap.
+//! in-process link it is a `Vec<u8>`. The [`PacketWriter`] of a link numbers the device's
+//! control packets (answers, errors, logs); each camera channel numbers its own frames'
+//! packets ([`Numbering`]) and writes them through the same writer, so the host sees a gap in
+//! any one source.
 
-use stereocal_wire::{encode, PacketRepr, MAX_FRAME_LEN};
+use stereocal_wire::{encode, PacketRepr, Source, MAX_FRAME_LEN};
+
+use crate::driver::numbering::Numbering;
 
 /// Takes complete wire frames (COBS bytes and the `0x00` delimiter), in order.
 ///
@@ -22,44 +25,46 @@ impl<S: ByteSink + ?Sized> ByteSink for &mut S {
     }
 }
 
-/// Encodes packets with consecutive sequence numbers into a [`ByteSink`].
+/// Encodes packets into a [`ByteSink`], numbering the control source's itself.
 pub struct PacketWriter<S: ByteSink> {
     sink: S,
-    next_seq: u16,
+    control: Numbering,
     frame: [u8; MAX_FRAME_LEN],
 }
 
 impl<S: ByteSink> PacketWriter<S> {
-    /// A writer whose first packet gets sequence number 0.
+    /// A writer whose first control packet gets sequence number 0.
     pub const fn new(sink: S) -> Self {
         Self {
             sink,
-            next_seq: 0,
+            control: Numbering::new(Source::Control),
             frame: [0; MAX_FRAME_LEN],
         }
     }
 
-    /// Encodes `packet` with the next sequence number and writes the frame to the sink.
-    ///
-    /// The sequence number is used up only when the packet was encoded, so a refused packet
-    /// leaves no gap.
+    /// Encodes `packet` as the control source's next packet and writes the frame to the sink.
     pub fn send(&mut self, packet: &PacketRepr<'_>) -> Result<(), stereocal_wire::Error> {
-        let frame = encode(self.next_seq, packet, &mut self.frame)?;
-        self.sink.write(frame);
-        self.next_seq = self.next_seq.wrapping_add(1);
-        Ok(())
+        let Self {
+            sink,
+            control,
+            frame,
+        } = self;
+        write(sink, frame, control, packet)
     }
 
-    /// Makes `seq` the next packet's sequence number: a stretch of a link's numbering can be
-    /// written apart from the rest (the host's in-process link runs the left camera on one
-    /// core while the right one runs on the other) and the link's writer then skips past it.
-    pub fn set_next_seq(&mut self, seq: u16) {
-        self.next_seq = seq;
+    /// Encodes `packet` as the next packet of `numbering`'s source (a camera channel's) and
+    /// writes the frame to the sink.
+    pub fn send_from(
+        &mut self,
+        numbering: &mut Numbering,
+        packet: &PacketRepr<'_>,
+    ) -> Result<(), stereocal_wire::Error> {
+        write(&mut self.sink, &mut self.frame, numbering, packet)
     }
 
-    /// The sequence number the next packet will carry.
-    pub fn next_seq(&self) -> u16 {
-        self.next_seq
+    /// The control source's numbering.
+    pub fn control(&self) -> &Numbering {
+        &self.control
     }
 
     /// The sink, e.g. to read back what a test collected.
@@ -76,4 +81,18 @@ impl<S: ByteSink> PacketWriter<S> {
     pub fn into_sink(self) -> S {
         self.sink
     }
+}
+
+/// Encodes `packet` with `numbering`'s next number and writes it to `sink`. The number is used
+/// up only when the packet was encoded, so a refused packet leaves no gap.
+fn write<S: ByteSink>(
+    sink: &mut S,
+    frame: &mut [u8; MAX_FRAME_LEN],
+    numbering: &mut Numbering,
+    packet: &PacketRepr<'_>,
+) -> Result<(), stereocal_wire::Error> {
+    let bytes = encode(numbering.source(), numbering.next_seq(), packet, frame)?;
+    sink.write(bytes);
+    numbering.advance();
+    Ok(())
 }

@@ -5,7 +5,7 @@
 
 extern crate std;
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::vec;
 use std::vec::Vec;
 
@@ -13,7 +13,7 @@ use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hdl::{register_at, regs, FabricConfig, PixelIn, RegisterBus};
 use stereocal_wire::{
     decode, Camera, ErrorCode, FrameEndFlags, Header, HelloRepr, PacketRepr, Point,
-    RegisterReadRepr, RegisterWriteRepr, SobelPixel, PATCH_PIXELS,
+    RegisterReadRepr, RegisterWriteRepr, SobelPixel, Source, PATCH_PIXELS,
 };
 
 use super::*;
@@ -77,15 +77,31 @@ enum Packet {
     End(stereocal_wire::FrameEndRepr),
 }
 
-/// Decodes every frame of `bytes`; also checks the sequence numbers count up from `first_seq`.
-fn decode_all(bytes: &[u8], first_seq: u16) -> Vec<Packet> {
+/// Decodes every frame of `bytes`; also checks that a frame's packets come from its camera's
+/// channel and the others from control, and that each source numbers its packets from 0
+/// without a gap.
+fn decode_all(bytes: &[u8]) -> Vec<Packet> {
     let mut packets = Vec::new();
-    let mut seq = first_seq;
+    let mut next_seq = BTreeMap::new();
     for frame in bytes.split_inclusive(|&b| b == 0) {
         let mut frame = frame.to_vec();
         let (header, repr): (Header, PacketRepr<'_>) = decode(&mut frame).expect("decodes");
-        assert_eq!(header.seq, seq, "sequence numbers have no gap");
-        seq = seq.wrapping_add(1);
+        let camera = match repr {
+            PacketRepr::FrameStart(p) => Some(p.camera),
+            PacketRepr::PointBatch(p) => Some(p.camera),
+            PacketRepr::SobelRows(p) => Some(p.camera),
+            PacketRepr::SobelPatch(p) => Some(p.camera),
+            PacketRepr::FrameEnd(p) => Some(p.camera),
+            _ => None,
+        };
+        assert_eq!(
+            header.source,
+            camera.map_or(Source::Control, Source::channel),
+            "{repr:?}"
+        );
+        let seq = next_seq.entry(header.source).or_insert(0u16);
+        assert_eq!(header.seq, *seq, "sequence numbers have no gap");
+        *seq = seq.wrapping_add(1);
         packets.push(match repr {
             PacketRepr::Hello(h) => Packet::Hello(h),
             PacketRepr::RegisterValue(v) => Packet::Value {
@@ -363,7 +379,7 @@ fn expected_patch(
 }
 
 #[test]
-fn frame_packets_come_in_order_with_consecutive_sequence_numbers() {
+fn frame_packets_come_in_order_with_consecutive_sequence_numbers_of_their_channel() {
     let script = Scripted {
         points: vec![(12, extremum(0, 20, 10)), (30, extremum(1, 5, 6))],
         ..Scripted::default()
@@ -377,7 +393,7 @@ fn frame_packets_come_in_order_with_consecutive_sequence_numbers() {
     assert_eq!(first.points, 2);
     assert_eq!(first.sobel_packets, 2);
 
-    let packets = decode_all(&link.sink().0, 0);
+    let packets = decode_all(&link.sink().0);
     let per_frame = packets.len() / 2;
     assert_eq!(
         packets[0],
@@ -464,7 +480,7 @@ fn rows_mode_sends_every_row_of_every_octave_once() {
     let summary = driver
         .process_frame(&vec![0u8; 48 * 40], 0, &mut link)
         .unwrap();
-    let packets = decode_all(&link.sink().0, 0);
+    let packets = decode_all(&link.sink().0);
     let mut seen = Vec::new();
     for p in &packets {
         if let Packet::Row {
@@ -526,7 +542,7 @@ fn patches_at_the_borders_are_zero_outside_the_image() {
         .process_frame(&vec![0u8; 48 * 36], 0, &mut link)
         .unwrap();
     assert_eq!(summary.patches_dropped, 0);
-    let patches: Vec<_> = decode_all(&link.sink().0, 0)
+    let patches: Vec<_> = decode_all(&link.sink().0)
         .into_iter()
         .filter_map(|p| match p {
             Packet::Patch {
@@ -574,7 +590,7 @@ fn fifo_overflow_is_counted_and_flagged() {
             sobel: 4
         }
     );
-    let packets = decode_all(&link.sink().0, 0);
+    let packets = decode_all(&link.sink().0);
     let Some(Packet::End(end)) = packets.last() else {
         panic!()
     };
@@ -608,7 +624,7 @@ fn rows_whose_pixels_were_all_dropped_are_not_sent() {
         .process_frame(&vec![0u8; 48 * 40], 0, &mut link)
         .unwrap();
     assert_eq!(summary.sobel_packets, 39);
-    let packets = decode_all(&link.sink().0, 0);
+    let packets = decode_all(&link.sink().0);
     assert!(!packets
         .iter()
         .any(|p| matches!(p, Packet::Row { row: 7, .. })));
@@ -638,7 +654,7 @@ fn points_too_late_for_the_ring_or_the_queue_are_counted() {
     assert_eq!(summary.points, MAX_PENDING as u32 + 6);
     assert_eq!(summary.patches_dropped, 1 + 5);
     assert_eq!(summary.sobel_packets, MAX_PENDING as u32);
-    let packets = decode_all(&link.sink().0, 0);
+    let packets = decode_all(&link.sink().0);
     let Some(Packet::End(end)) = packets.last() else {
         panic!()
     };
@@ -704,7 +720,7 @@ fn host_packets_are_answered() {
         driver.handle_host_packet(request, &mut link).unwrap();
     }
     assert_eq!(
-        decode_all(&link.sink().0, 0),
+        decode_all(&link.sink().0),
         [
             Packet::Hello(HelloRepr {
                 version: stereocal_wire::PROTOCOL_VERSION,
@@ -731,7 +747,7 @@ fn host_packets_are_answered() {
                 detail: 0x0006
             },
             Packet::Error {
-                code: ErrorCode::Unknown(ERROR_UNEXPECTED_KIND),
+                code: ErrorCode::UnexpectedKind,
                 detail: 0x14
             },
         ]
@@ -765,10 +781,7 @@ fn bad_configuration_or_image_sends_nothing() {
     ));
     assert_eq!(
         err.report(),
-        (
-            ErrorCode::Unknown(ERROR_INVALID_CONFIG),
-            u32::from(regs::width::OFFSET)
-        )
+        (ErrorCode::InvalidConfig, u32::from(regs::width::OFFSET))
     );
     driver.bus_mut().write(regs::width::OFFSET, 96);
     assert!(matches!(
@@ -961,7 +974,7 @@ fn fast_path_points_and_patches_match_its_sobel_images() {
     assert_eq!(summary.patches_dropped, 0);
     assert_eq!(summary.points as usize, reference.points.len());
 
-    let packets = decode_all(&link.sink().0, 0);
+    let packets = decode_all(&link.sink().0);
     let sent: Vec<Point> = packets
         .iter()
         .filter_map(|p| match p {
@@ -1019,7 +1032,7 @@ fn fast_path_rows_are_its_sobel_images() {
     let mut link = PacketWriter::new(Collect::default());
     driver.process_frame(&image, 0, &mut link).unwrap();
     let mut rows = 0;
-    for p in decode_all(&link.sink().0, 0) {
+    for p in decode_all(&link.sink().0) {
         if let Packet::Row {
             octave,
             row,
@@ -1100,7 +1113,7 @@ fn register_level_model_sends_the_same_records_as_the_fast_path() {
         let mut link = PacketWriter::new(Collect::default());
         let summary = driver.process_frame(&image, 0, &mut link).unwrap();
         assert!(summary.points > 0);
-        results.push(normalized(decode_all(&link.sink().0, 0)));
+        results.push(normalized(decode_all(&link.sink().0)));
     }
     assert_eq!(results[0], results[1]);
 }

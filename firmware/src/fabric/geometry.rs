@@ -1,16 +1,8 @@
 //! Frame geometry shared by every stage: octave sizes and the raster position counter.
 
-/// Size of octave `k` for a `width` x `height` input: each octave keeps the even columns and
-/// the even rows of the previous one, so sizes round up (`(n + 1) / 2`).
-pub const fn octave_dims(width: u16, height: u16, k: u8) -> (u16, u16) {
-    let (mut w, mut h, mut i) = (width, height, 0);
-    while i < k {
-        w = w.div_ceil(2);
-        h = h.div_ceil(2);
-        i += 1;
-    }
-    (w, h)
-}
+/// The octave sizes are part of the wire format (a receiver places octave-local coordinates
+/// by them), so the fabric builds its octaves by the wire crate's rule.
+pub use stereocal_wire::octave_dims;
 
 /// Raster position counter (the column and row counters every stage keeps in hardware).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

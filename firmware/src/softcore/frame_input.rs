@@ -43,7 +43,8 @@ pub const FLAG_AUTOSTART: u16 = 1 << 0;
 pub const FLAG_REGISTER_MODEL: u16 = 1 << 1;
 /// After every image, log the instructions it took (`minstret`; instructions only under
 /// QEMU's `-icount`) in the front end and in the whole frame. Off by default: the log packets
-/// take sequence numbers, so a run with them is not byte-identical to the in-process device.
+/// are packets the in-process device does not send, so a run with them is not byte-identical
+/// to it.
 pub const FLAG_COUNT_INSTRUCTIONS: u16 = 1 << 2;
 const KNOWN_FLAGS: u16 = FLAG_AUTOSTART | FLAG_REGISTER_MODEL | FLAG_COUNT_INSTRUCTIONS;
 

@@ -1,8 +1,10 @@
-//! The soft-core's end of the link: UART0 as a [`ByteSink`] and the one [`PacketWriter`] that
-//! numbers every packet the firmware sends.
+//! The soft-core's end of the link: UART0 as a [`ByteSink`] and the one [`PacketWriter`] every
+//! packet the firmware sends goes through.
 //!
-//! The driver's packets, the defmt log packets and the panic report all go through [`LINK`],
-//! so they share one sequence counter and the host's gap detection sees a single stream.
+//! The driver's packets, the defmt log packets and the panic report all go through [`LINK`]:
+//! the soft-core's own packets (answers, errors, logs, the panic report) as its control
+//! source, numbered by the writer; each camera channel's as that channel's source, numbered
+//! by the channel.
 
 use core::cell::RefCell;
 

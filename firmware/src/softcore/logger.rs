@@ -2,9 +2,9 @@
 //!
 //! defmt calls `acquire`, then `write` any number of times, then `release` for one log frame.
 //! The frame is collected in a buffer of [`MAX_LOG_LEN`] bytes and sent as one packet in
-//! `release`, through [`LINK`] so it takes the next sequence number. The whole sequence runs
-//! inside a critical section (interrupts off on the single hart), which is what makes the
-//! unsynchronised state below sound.
+//! `release`, through [`LINK`] so it takes the control source's next sequence number. The
+//! whole sequence runs inside a critical section (interrupts off on the single hart), which is
+//! what makes the unsynchronised state below sound.
 //!
 //! A frame longer than [`MAX_LOG_LEN`] cannot be decoded once cut, so it is not sent; it is
 //! counted in [`dropped_logs`]. So is a log call made while the firmware holds [`LINK`] (the

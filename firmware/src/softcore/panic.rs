@@ -3,7 +3,7 @@
 //! A panic is a firmware bug (data from the link or the input region is checked and answered
 //! with errors, never a panic). The handler ends whatever frame the panic interrupted with a
 //! lone delimiter, logs the panic message and location as a defmt error (a `Log` packet with
-//! the next sequence number), and exits QEMU through the `sifive_test` finisher with
+//! the control source's next sequence number), and exits QEMU through the `sifive_test` finisher with
 //! [`ExitCode::Panic`]. A panic inside the handler exits at once.
 
 use core::panic::PanicInfo;

@@ -13,6 +13,7 @@ use std::thread;
 use std::time::Duration;
 
 use stereocal::link::{InProcessLink, Link, TimedStream};
+use stereocal_wire::EncodersRepr;
 
 const BIN: &str = env!("CARGO_BIN_EXE_stereocal");
 const FRAMES: usize = 4;
@@ -95,34 +96,6 @@ fn encoder_yaws_udeg(i: usize) -> (i32, i32) {
     (800_000 + 300_000 * i as i32, -800_000)
 }
 
-/// Re-numbers the link frames in `bytes` from `seq` on, with an `Encoders` packet for frame id
-/// `encoders_for` first when given: the device model numbers only its own packets, and a head
-/// whose firmware reads encoders numbers them all in one sequence.
-fn resequence(bytes: &[u8], seq: &mut u16, encoders_for: Option<usize>) -> Vec<u8> {
-    use stereocal_wire::{decode, encode, EncodersRepr, PacketRepr, MAX_FRAME_LEN};
-    let mut out = Vec::new();
-    let mut buf = [0u8; MAX_FRAME_LEN];
-    let mut put = |repr: &PacketRepr<'_>, out: &mut Vec<u8>| {
-        out.extend_from_slice(encode(*seq, repr, &mut buf).unwrap());
-        *seq = seq.wrapping_add(1);
-    };
-    if let Some(i) = encoders_for {
-        let (left_yaw_udeg, right_yaw_udeg) = encoder_yaws_udeg(i);
-        let reading = EncodersRepr {
-            frame_id: i as u32,
-            left_yaw_udeg,
-            right_yaw_udeg,
-        };
-        put(&PacketRepr::Encoders(reading), &mut out);
-    }
-    for frame in bytes.split_inclusive(|&b| b == 0) {
-        let mut frame = frame.to_vec();
-        let (_, repr) = decode(&mut frame).unwrap();
-        put(&repr, &mut out);
-    }
-    out
-}
-
 fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool, q: Quirks) {
     let left = sorted_images(&dir.join("left"));
     let right = sorted_images(&dir.join("right"));
@@ -137,7 +110,6 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
     let mut buf = [0u8; 4096];
     let mut out = Vec::new();
     let mut grabbed = false;
-    let mut seq = 0u16;
     loop {
         match stream.read(&mut buf) {
             Ok(0) => return,
@@ -145,28 +117,35 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
             Err(_) => return,
         }
-        let mut send = |device: &mut InProcessLink, damage: bool, pair: Option<usize>| {
+        let mut send = |device: &mut InProcessLink, damage: bool| {
             out.clear();
             Link::take_sent(device, &mut out).unwrap();
-            if q.encoders {
-                out = resequence(&out, &mut seq, pair);
-            }
             if damage {
                 let middle = out.len() / 2;
                 out[middle] ^= 0x5a;
             }
             stream.write_all(&out).is_ok()
         };
-        if !send(&mut device, false, None) {
+        if !send(&mut device, false) {
             return;
         }
         if device.enabled() && !grabbed {
             grabbed = true;
             for (i, (l, r)) in left.iter().zip(&right).take(pairs).enumerate() {
+                if q.encoders {
+                    let (left_yaw_udeg, right_yaw_udeg) = encoder_yaws_udeg(i);
+                    device
+                        .send_encoders(EncodersRepr {
+                            frame_id: i as u32,
+                            left_yaw_udeg,
+                            right_yaw_udeg,
+                        })
+                        .unwrap();
+                }
                 device
                     .submit_pair(l, r, (i as f64 * PERIOD_US).round() as u64)
                     .unwrap();
-                if !send(&mut device, q.damage == Some(i), Some(i)) {
+                if !send(&mut device, q.damage == Some(i)) {
                     return;
                 }
             }

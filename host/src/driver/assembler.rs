@@ -1,19 +1,20 @@
 //! Decoded packets in, camera frames out: the receiving state machine of the driver.
 //!
 //! Link-independent and synchronous, so every damage case is tested with hand-built packet
-//! sequences. One frame is assembled at a time (the soft-core sends a camera frame's packets
-//! contiguously, log packets aside). A frame is *damaged* when a packet of it may be
-//! missing (a sequence gap or an undecodable frame while it is open, a `FrameStart` before
-//! its `FrameEnd`, no `FrameStart` at all) or when its contents are inconsistent; a damaged
-//! frame is consumed up to its end, reported once and dropped. The next `FrameStart` always
-//! starts afresh, which is the resynchronisation.
+//! sequences. One frame is assembled at a time (the device sends a camera frame's packets
+//! contiguously, control packets aside). Each wire source numbers its packets on its own, so
+//! the sequence numbers are checked per source. A frame is *damaged* when a packet of it may
+//! be missing (a gap in its channel's numbering or an undecodable frame while it is open, a
+//! `FrameStart` before its `FrameEnd`, no `FrameStart` at all) or when its contents are
+//! inconsistent; a damaged frame is consumed up to its end, reported once and dropped. The
+//! next `FrameStart` always starts afresh, which is the resynchronisation.
 
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 
 use stereocal_hdl::regs;
 use stereocal_wire::{
     Camera, EncodersRepr, ErrorReportRepr, FrameEndFlags, FrameEndRepr, FrameStartRepr, Header,
-    HelloRepr, PacketKind, PacketRepr, Point, RegisterValueRepr,
+    HelloRepr, PacketKind, PacketRepr, Point, RegisterValueRepr, Source,
 };
 
 use super::damage::{ContentError, Damage, PacketRef};
@@ -21,7 +22,7 @@ use super::gradients::{FinishError, GradientBuilder};
 use super::keypoint::keypoint;
 use super::stats::LinkStats;
 use crate::features::{FeatureFrame, Keypoint};
-use stereocal_firmware::fabric::geometry::octave_dims;
+use stereocal_wire::octave_dims;
 
 /// A camera frame that arrived complete and consistent.
 #[derive(Debug, Clone, PartialEq)]
@@ -165,10 +166,11 @@ impl Partial {
 /// The receiving state machine.
 #[derive(Debug, Default)]
 pub(crate) struct FrameAssembler {
-    last_seq: Option<u16>,
+    /// The last sequence number of each source seen since the device's `Hello`.
+    last_seq: HashMap<Source, u16>,
+    /// The sequence number of the last packet that decoded, of any source (for reports).
+    last_decoded: Option<u16>,
     partial: Option<Partial>,
-    /// Intact packets of unknown kind since the last decoded one (each took a number).
-    unknown_since_last: u16,
     events: VecDeque<Event>,
     pub stats: LinkStats,
 }
@@ -257,24 +259,38 @@ impl FrameAssembler {
             .map(|p| (p.frame_id, p.camera, p.packets))
     }
 
-    /// A link frame that did not decode; `wire_len` is the bytes it took.
+    /// A link frame that did not decode; `wire_len` is the bytes it took, `header` its header
+    /// when the packet was intact up to its payload.
     ///
-    /// An intact packet of a kind this host does not know (a newer device may add kinds
-    /// within a version) is counted and skipped without damage; it used up one sequence
-    /// number, which [`Self::check_seq`] allows for.
-    pub fn undecodable(&mut self, error: stereocal_wire::Error, wire_len: usize) {
-        if error == stereocal_wire::Error::DecodeUnknownKind {
+    /// An intact packet still used up a number of its source, which is checked as any
+    /// packet's. One of a kind this host does not know (a newer device may add kinds within a
+    /// version) is then counted and skipped without damage; one whose payload breaks its
+    /// kind's layout damages the open frame only when it comes from the frame's channel. A
+    /// damaged packet may have come from any source, so it damages the open frame.
+    pub fn undecodable(
+        &mut self,
+        error: stereocal_wire::Error,
+        header: Option<Header>,
+        wire_len: usize,
+    ) {
+        let mut ours = true;
+        if let Some(header) = header {
+            self.number(&header);
+            ours = self
+                .partial
+                .as_ref()
+                .is_some_and(|p| Source::channel(p.camera) == header.source);
+        }
+        if let Some(p) = &mut self.partial {
+            p.wire_bytes += wire_len as u64;
+        }
+        if header.is_some() && error == stereocal_wire::Error::DecodeUnknownKind {
             self.stats.unknown_kinds += 1;
-            self.unknown_since_last = self.unknown_since_last.wrapping_add(1);
-            if let Some(p) = &mut self.partial {
-                p.wire_bytes += wire_len as u64;
-            }
             return;
         }
         self.stats.undecodable += 1;
-        let after_seq = self.last_seq.unwrap_or(0);
-        if let Some(p) = &mut self.partial {
-            p.wire_bytes += wire_len as u64;
+        let after_seq = self.last_decoded.unwrap_or(0);
+        if let Some(p) = self.partial.as_mut().filter(|_| ours) {
             p.damage(Damage::Undecodable { after_seq, error });
         }
     }
@@ -282,27 +298,40 @@ impl FrameAssembler {
     /// A link frame longer than any packet.
     pub fn over_long(&mut self, wire_len: usize) {
         self.stats.over_long += 1;
-        let after_seq = self.last_seq.unwrap_or(0);
+        let after_seq = self.last_decoded.unwrap_or(0);
         if let Some(p) = &mut self.partial {
             p.wire_bytes += wire_len as u64;
             p.damage(Damage::OverLong { after_seq });
         }
     }
 
-    /// Checks the sequence number; returns the expected one when it jumped.
-    fn check_seq(&mut self, seq: u16) -> Option<u16> {
-        let skipped = std::mem::take(&mut self.unknown_since_last);
-        let gap = match self.last_seq {
-            Some(last) if seq != last.wrapping_add(1).wrapping_add(skipped) => {
-                let expected = last.wrapping_add(1).wrapping_add(skipped);
-                self.stats.sequence_gaps += 1;
-                self.stats.packets_lost += u64::from(seq.wrapping_sub(expected));
-                Some(expected)
-            }
-            _ => None,
+    /// Checks an intact packet's sequence number against its source's last; a jump counts
+    /// as a gap and, when the open frame's channel jumped, damages the frame.
+    fn number(&mut self, header: &Header) {
+        let (source, seq) = (header.source, header.seq);
+        self.last_decoded = Some(seq);
+        let Some(last) = self.last_seq.insert(source, seq) else {
+            return;
         };
-        self.last_seq = Some(seq);
-        gap
+        let expected = last.wrapping_add(1);
+        if seq == expected {
+            return;
+        }
+        self.stats.sequence_gaps += 1;
+        self.stats.packets_lost += u64::from(seq.wrapping_sub(expected));
+        // A gap in the frame's channel may have swallowed any of its packets.
+        if let Some(p) = self
+            .partial
+            .as_mut()
+            .filter(|p| Source::channel(p.camera) == source)
+        {
+            p.damage(Damage::SequenceGap {
+                sender: source,
+                expected,
+                got: seq,
+                kind: header.kind,
+            });
+        }
     }
 
     /// A decoded packet; `wire_len` is the link bytes it took (delimiter and any noise
@@ -311,10 +340,11 @@ impl FrameAssembler {
         self.stats.packets += 1;
         let seq = header.seq;
         if let PacketRepr::Hello(hello) = packet {
-            // A device that says Hello has (re)started: its numbering starts over, and a
-            // frame it was sending will not be finished.
-            self.last_seq = Some(seq);
-            self.unknown_since_last = 0;
+            // A device that says Hello has (re)started: every source's numbering starts
+            // over, and a frame it was sending will not be finished.
+            self.last_seq.clear();
+            self.last_seq.insert(header.source, seq);
+            self.last_decoded = Some(seq);
             if let Some(p) = self.partial.take() {
                 let next = PacketRef {
                     kind: header.kind,
@@ -327,15 +357,7 @@ impl FrameAssembler {
             self.events.push_back(Event::Hello(*hello));
             return;
         }
-        let gap = self.check_seq(seq);
-        // A gap inside a frame may have swallowed any of its packets.
-        if let (Some(expected), Some(p)) = (gap, &mut self.partial) {
-            p.damage(Damage::SequenceGap {
-                expected,
-                got: seq,
-                kind: header.kind,
-            });
-        }
+        self.number(header);
         match packet {
             PacketRepr::Log(log) => {
                 self.stats.log_frames += 1;

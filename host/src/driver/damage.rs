@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use stereocal_wire::{Camera, PacketKind};
+use stereocal_wire::{Camera, PacketKind, Source};
 
 use crate::features::FeatureError;
 
@@ -34,9 +34,11 @@ impl fmt::Display for PacketRef {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum Damage {
-    /// Packets were lost: the sequence number jumped.
-    #[error("sequence gap: expected seq {expected}, got {got} ({kind:?})")]
+    /// Packets were lost: the sequence number of the frame's source jumped.
+    #[error("sequence gap in source {sender:?}: expected seq {expected}, got {got} ({kind:?})")]
     SequenceGap {
+        /// The wire source whose numbering jumped: the frame's camera channel.
+        sender: Source,
         /// The sequence number that should have come.
         expected: u16,
         /// The one that came.
@@ -47,7 +49,7 @@ pub enum Damage {
     /// A frame on the link failed to decode (COBS, CRC, version, length, kind, fields).
     #[error("undecodable packet after seq {after_seq}: {error}")]
     Undecodable {
-        /// The last sequence number that decoded.
+        /// The sequence number of the last packet that decoded, of any source.
         after_seq: u16,
         /// The wire crate's reason.
         error: stereocal_wire::Error,
@@ -55,7 +57,7 @@ pub enum Damage {
     /// A frame on the link was longer than any packet and was skipped.
     #[error("over-long packet after seq {after_seq} skipped")]
     OverLong {
-        /// The last sequence number that decoded.
+        /// The sequence number of the last packet that decoded, of any source.
         after_seq: u16,
     },
     /// The next frame started before this one's `FrameEnd`.

@@ -5,9 +5,8 @@
 //! `PointBatch`: the soft-core cuts a patch as soon as its rows are in, and flushes points in
 //! batches), placed on its point's octave pixel.
 
-use stereocal_firmware::fabric::geometry::octave_dims;
 use stereocal_wire::{
-    Point, Record, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, PATCH_PIXELS,
+    octave_dims, Point, Record, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, PATCH_PIXELS,
 };
 
 use super::damage::ContentError;

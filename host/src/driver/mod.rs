@@ -36,7 +36,7 @@ use std::time::{Duration, Instant};
 use stereocal_hdl::{FabricConfig, Registers};
 use stereocal_wire::{
     encode, Accumulator, Camera, EncodersRepr, ErrorReportRepr, FeedResult, HelloRepr, PacketRepr,
-    RegisterReadRepr, RegisterWriteRepr, MAX_FRAME_LEN, PROTOCOL_VERSION,
+    RegisterReadRepr, RegisterWriteRepr, Source, MAX_FRAME_LEN, PROTOCOL_VERSION,
 };
 
 pub use assembler::{DamagedFrame, FrameOutcome, LogFrame, ReceivedFrame};
@@ -112,7 +112,7 @@ const MAX_ENCODER_READINGS: usize = 64;
 /// An `ErrorReport` the device sent outside a request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DeviceReport {
-    /// Sequence number of the packet.
+    /// Sequence number of the packet, in the device's control source.
     pub seq: u16,
     /// The report.
     pub report: ErrorReportRepr,
@@ -342,7 +342,8 @@ impl<L: Link> Driver<L> {
 
     /// Encodes and sends one request.
     fn send(&mut self, packet: &PacketRepr<'_>) -> Result<(), DriverError> {
-        let frame = encode(self.tx_seq, packet, &mut self.tx).map_err(DriverError::Encode)?;
+        let frame = encode(Source::Control, self.tx_seq, packet, &mut self.tx)
+            .map_err(DriverError::Encode)?;
         self.link.send(frame).map_err(DriverError::Link)?;
         self.assembler.stats.bytes_sent += frame.len() as u64;
         self.tx_seq = self.tx_seq.wrapping_add(1);
@@ -397,9 +398,13 @@ impl<L: Link> Driver<L> {
                     self.assembler.over_long(wire);
                     (rest.len(), Some(wire))
                 }
-                FeedResult::DecodeError { error, remaining } => {
+                FeedResult::DecodeError {
+                    error,
+                    header,
+                    remaining,
+                } => {
                     let wire = self.wire_pending + input.len() - remaining.len();
-                    self.assembler.undecodable(error, wire);
+                    self.assembler.undecodable(error, header, wire);
                     (remaining.len(), Some(wire))
                 }
                 FeedResult::Success {

@@ -8,8 +8,9 @@
 //! [`InProcessLink::register_level`] asks for the clock-level model.
 //!
 //! The two cameras' channels run on two cores at once ([`InProcessLink::submit_pair`]) and
-//! their packets are queued left camera first, numbered as one soft-core serving both would
-//! number them, so the bytes equal the soft-core's.
+//! their packets are queued left camera first, as the soft-core sends them. Each channel
+//! numbers its packets as its own wire source, so the bytes equal the soft-core's whichever
+//! channel finishes first, and nothing rewrites a channel's frames.
 //!
 //! Register writes from the host go to both channels (the head's two fabrics are configured
 //! alike); `Hello` and register reads are answered by the left channel, so each request gets
@@ -23,9 +24,8 @@ use stereocal_firmware::driver::{
 use stereocal_firmware::fabric::{FabricDevice, FabricModel};
 use stereocal_hdl::regs::control;
 use stereocal_hdl::RegisterBus;
-use stereocal_wire::{decode, Accumulator, Camera, FeedResult, PacketRepr, MAX_FRAME_LEN};
+use stereocal_wire::{Accumulator, Camera, EncodersRepr, FeedResult, PacketRepr, MAX_FRAME_LEN};
 
-use super::renumber::renumber_in_place;
 use super::{Link, LinkError};
 
 /// Name in errors.
@@ -40,16 +40,11 @@ type FullChannel = Channel<FabricDevice<FabricModel>, 1280>;
 struct Outbox {
     bytes: Vec<u8>,
     read: usize,
-    /// Where each write ended. A packet writer writes one frame per call, so for the right
-    /// camera's outbox these are its frames' ends: they are renumbered without a scan for
-    /// delimiters.
-    write_ends: Vec<usize>,
 }
 
 impl ByteSink for Outbox {
     fn write(&mut self, bytes: &[u8]) {
         self.bytes.extend_from_slice(bytes);
-        self.write_ends.push(self.bytes.len());
     }
 }
 
@@ -57,7 +52,6 @@ impl Outbox {
     /// Empties the outbox and keeps its allocations.
     fn clear(&mut self) {
         self.bytes.clear();
-        self.write_ends.clear();
         self.read = 0;
     }
 
@@ -70,7 +64,6 @@ impl Outbox {
         } else {
             self.bytes.append(bytes);
         }
-        self.write_ends.push(self.bytes.len());
     }
 
     /// Moves the unread bytes into `out`. An empty `out` trades buffers with the outbox
@@ -91,7 +84,8 @@ pub struct InProcessLink {
     right: Box<FullChannel>,
     writer: PacketWriter<Outbox>,
     /// Each camera's packets of the pair being run, before they join `writer`'s outbox; kept
-    /// from pair to pair for their allocations.
+    /// from pair to pair for their allocations. Only their sinks and frame buffers are used:
+    /// the channels number their own packets.
     pair_out: [PacketWriter<Outbox>; 2],
     inbox: Box<Accumulator<{ MAX_FRAME_LEN - 1 }>>,
 }
@@ -143,16 +137,16 @@ impl InProcessLink {
     /// Runs a stereo pair: the frame's packets of both cameras wait in the outbox, the left
     /// camera's first, the two frames carry the same frame id.
     ///
-    /// The channels run concurrently. The left one numbers its packets from the link's next
-    /// sequence number; the right one's are numbered from 0 and, once the left has finished,
-    /// given the numbers that follow the left camera's (in place where the frame allows,
-    /// `renumber_in_place`, else decoded and sent again through the link's writer): the
-    /// bytes are those of running the two one after the other.
+    /// The channels run concurrently, each into an outbox of its own, numbering its packets
+    /// as its source; the two outboxes then join the link's as they are, left first: the
+    /// bytes are those of running the two one after the other, as the soft-core does.
     /// Run one after the other, a left frame refused before its `FrameStart` (a wrong image
     /// size; register errors refuse both alike) would leave the right camera unrun and both
     /// frame numbers unused: images of different sizes therefore run one after the other, and
-    /// any other failure leaves both channels past the frame, their numbers in step. A left
-    /// failure discards the right camera's packets.
+    /// any other failure leaves both channels past the frame, their frame numbers in step.
+    /// What a failed channel sent stays in the outbox, beside the other channel's frame, as
+    /// the soft-core sends on with the next camera after reporting a failure; the left
+    /// failure is returned first.
     pub fn submit_pair(
         &mut self,
         left: &[u8],
@@ -174,41 +168,23 @@ impl InProcessLink {
         } = self;
         left_out.sink_mut().clear();
         right_out.sink_mut().clear();
-        left_out.set_next_seq(writer.next_seq());
-        right_out.set_next_seq(0);
         let (left_result, right_result) = rayon::join(
             || left_channel.process_frame(left, timestamp_us, left_out),
             || right_channel.process_frame(right, timestamp_us, right_out),
         );
         writer.sink_mut().append(&mut left_out.sink_mut().bytes);
-        writer.set_next_seq(left_out.next_seq());
+        writer.sink_mut().append(&mut right_out.sink_mut().bytes);
         let left_summary = left_result.map_err(|e| channel_error(Camera::Left, &e))?;
-        let Outbox {
-            bytes: right_bytes,
-            write_ends,
-            ..
-        } = right_out.sink_mut();
-        let mut start = 0;
-        for &end in write_ends.iter() {
-            let frame = right_bytes.get_mut(start..end).unwrap_or_default();
-            start = end;
-            let seq = writer.next_seq();
-            if renumber_in_place(frame, seq) {
-                writer.sink_mut().write(frame);
-                writer.set_next_seq(seq.wrapping_add(1));
-                continue;
-            }
-            let (_, packet) = decode(frame).map_err(|e| {
-                LinkError::Device(format!(
-                    "right channel: its own packet does not decode: {e}"
-                ))
-            })?;
-            writer
-                .send(&packet)
-                .map_err(|e| LinkError::Device(format!("right channel: re-encoding: {e}")))?;
-        }
         let right_summary = right_result.map_err(|e| channel_error(Camera::Right, &e))?;
         Ok([left_summary, right_summary])
+    }
+
+    /// Sends a reading of the head's joint encoders, as a head whose firmware reads them
+    /// does: a control packet of the device, before or after the capture's camera frames.
+    pub fn send_encoders(&mut self, reading: EncodersRepr) -> Result<(), LinkError> {
+        self.writer
+            .send(&PacketRepr::Encoders(reading))
+            .map_err(|e| LinkError::Device(format!("encoders reading: {e}")))
     }
 
     /// Whether the host has set CONTROL.ENABLE: a head with its own cameras (the firmware's

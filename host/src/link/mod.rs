@@ -27,7 +27,6 @@ mod frame_input;
 mod in_process;
 mod own_cameras;
 mod recording;
-mod renumber;
 mod replay;
 mod serial;
 mod stream;

@@ -1,17 +1,18 @@
 //! Hand-built wire traffic for the driver and link tests: packets encoded with the wire
-//! crate, numbered like the soft-core numbers them, with a record of where each one sits so
+//! crate, each numbered as its source like the soft-core numbers them (a frame's packets as
+//! its camera's channel, every other packet as control), with a record of where each one sits so
 //! a test can drop, cut or corrupt exactly one.
 #![allow(dead_code)] // each test binary uses part of the fixture
 
 pub mod device;
 
+use std::collections::BTreeMap;
 use std::ops::Range;
 
-use stereocal_firmware::fabric::geometry::octave_dims;
 use stereocal_wire::{
-    encode, Camera, FrameEndFlags, FrameEndRepr, FrameStartRepr, LogRepr, PacketRepr, Point,
-    PointBatchRepr, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, MAX_FRAME_LEN, MAX_POINTS,
-    PATCH_PIXELS,
+    encode, octave_dims, Camera, FrameEndFlags, FrameEndRepr, FrameStartRepr, LogRepr, PacketRepr,
+    Point, PointBatchRepr, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, Source,
+    MAX_FRAME_LEN, MAX_POINTS, PATCH_PIXELS,
 };
 
 /// The Sobel pixel the fixture sends at octave pixel `(x, y)` of `octave`.
@@ -79,7 +80,22 @@ pub fn point(x: u16, y: u16, octave: u8, dx: i16, dy: i16) -> Point {
 pub struct Wire {
     pub bytes: Vec<u8>,
     pub packets: Vec<Range<usize>>,
-    seq: u16,
+    /// The next sequence number of each source.
+    seq: BTreeMap<Source, u16>,
+}
+
+/// The source the device sends `packet` as: a frame's packets its camera's channel, any
+/// other packet control.
+pub fn source_of(packet: &PacketRepr<'_>) -> Source {
+    let camera = match packet {
+        PacketRepr::FrameStart(p) => p.camera,
+        PacketRepr::PointBatch(p) => p.camera,
+        PacketRepr::SobelRows(p) => p.camera,
+        PacketRepr::SobelPatch(p) => p.camera,
+        PacketRepr::FrameEnd(p) => p.camera,
+        _ => return Source::Control,
+    };
+    Source::channel(camera)
 }
 
 impl Wire {
@@ -87,16 +103,25 @@ impl Wire {
         Self::default()
     }
 
-    /// Sequence number the next packet gets.
-    pub fn next_seq(&self) -> u16 {
-        self.seq
+    /// Sequence number the next packet of `source` gets.
+    pub fn next_seq(&self, source: Source) -> u16 {
+        self.seq.get(&source).copied().unwrap_or(0)
     }
 
-    /// Encodes `packet` with the next sequence number.
+    /// Uses up the next sequence number of `source`.
+    fn take_seq(&mut self, source: Source) -> u16 {
+        let next = self.seq.entry(source).or_insert(0);
+        let seq = *next;
+        *next = seq.wrapping_add(1);
+        seq
+    }
+
+    /// Encodes `packet` with the next sequence number of its source.
     pub fn push(&mut self, packet: &PacketRepr<'_>) -> Range<usize> {
         let mut buf = [0u8; MAX_FRAME_LEN];
-        let frame = encode(self.seq, packet, &mut buf).expect("fixture packets encode");
-        self.seq = self.seq.wrapping_add(1);
+        let source = source_of(packet);
+        let seq = self.take_seq(source);
+        let frame = encode(source, seq, packet, &mut buf).expect("fixture packets encode");
         let start = self.bytes.len();
         self.bytes.extend_from_slice(frame);
         let range = start..self.bytes.len();
@@ -107,8 +132,9 @@ impl Wire {
     /// A packet the device numbered but the link lost.
     pub fn lose(&mut self, packet: &PacketRepr<'_>) {
         let mut buf = [0u8; MAX_FRAME_LEN];
-        encode(self.seq, packet, &mut buf).expect("fixture packets encode");
-        self.seq = self.seq.wrapping_add(1);
+        let source = source_of(packet);
+        let seq = self.take_seq(source);
+        encode(source, seq, packet, &mut buf).expect("fixture packets encode");
     }
 
     /// Bytes that are no packet.
@@ -243,16 +269,16 @@ pub fn frame_packets(spec: &FrameSpec) -> Vec<Owned> {
 }
 
 impl Wire {
-    /// An intact packet of a kind the host does not know (a newer device's), numbered like
-    /// the others. Built by hand because the wire crate only encodes kinds it knows.
-    pub fn unknown_kind(&mut self, kind: u8, payload: &[u8]) {
-        let mut packet = vec![stereocal_wire::PROTOCOL_VERSION, kind];
-        packet.extend_from_slice(&self.seq.to_le_bytes());
+    /// An intact packet of a kind the host does not know (a newer device's) from `source`,
+    /// numbered like the others. Built by hand because the wire crate only encodes kinds it
+    /// knows.
+    pub fn unknown_kind(&mut self, source: Source, kind: u8, payload: &[u8]) {
+        let mut packet = vec![stereocal_wire::PROTOCOL_VERSION, kind, u8::from(source)];
+        packet.extend_from_slice(&self.take_seq(source).to_le_bytes());
         packet.extend_from_slice(&(payload.len() as u16).to_le_bytes());
         packet.extend_from_slice(payload);
         let crc = stereocal_wire::crc32c(&packet);
         packet.extend_from_slice(&crc.to_le_bytes());
-        self.seq = self.seq.wrapping_add(1);
         let start = self.bytes.len();
         let mut encoded = vec![0u8; cobs::max_encoding_length(packet.len())];
         let n = cobs::encode(&packet, &mut encoded);

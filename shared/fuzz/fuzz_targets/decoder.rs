@@ -9,7 +9,8 @@
 
 use libfuzzer_sys::fuzz_target;
 use stereocal_wire::{
-    decode, encode, Accumulator, FeedResult, PacketRepr, RegisterReadRepr, DELIMITER, MAX_FRAME_LEN,
+    decode, encode, Accumulator, FeedResult, PacketRepr, RegisterReadRepr, Source, DELIMITER,
+    MAX_FRAME_LEN,
 };
 
 const MARKER_SEQ: u16 = 0xBEEF;
@@ -27,12 +28,12 @@ fn feed_all<const N: usize>(acc: &mut Accumulator<N>, mut window: &[u8]) {
                 remaining,
             } => {
                 let mut buf = [0u8; MAX_FRAME_LEN];
-                let frame =
-                    encode(header.seq, &packet, &mut buf).expect("a decoded packet re-encodes");
+                let frame = encode(header.source, header.seq, &packet, &mut buf)
+                    .expect("a decoded packet re-encodes");
                 let mut frame = frame.to_vec();
                 let (again_header, again) =
                     decode(&mut frame).expect("a re-encoded packet decodes");
-                assert_eq!(again_header.seq, header.seq);
+                assert_eq!(again_header, header);
                 assert_eq!(again, packet);
                 remaining
             }
@@ -60,7 +61,8 @@ fn resyncs<const N: usize>(acc: &mut Accumulator<N>, marker_frame: &[u8]) {
 
 fuzz_target!(|data: &[u8]| {
     let mut marker_buf = [0u8; MAX_FRAME_LEN];
-    let marker_frame = encode(MARKER_SEQ, &MARKER, &mut marker_buf).expect("the marker encodes");
+    let marker_frame =
+        encode(Source::Control, MARKER_SEQ, &MARKER, &mut marker_buf).expect("the marker encodes");
 
     let split = data.first().map_or(0, |&b| usize::from(b)).min(data.len());
     let (head, tail) = data.split_at(split);

@@ -69,6 +69,14 @@ pub enum ErrorCode {
     /// `0x0004`: the device is not ready for the request (e.g. a frame is in flight);
     /// `detail` is the packet kind byte of the refused request.
     Busy,
+    /// `0x0100`: the fabric's registers hold a configuration it cannot run; `detail` is the
+    /// byte address of the register at fault (`0xFFFF_FFFF` when no one register is).
+    InvalidConfig,
+    /// `0x0101`: the host sent a kind only the device sends; `detail` is the kind byte.
+    UnexpectedKind,
+    /// `0x0102`: a camera frame could not be processed; `detail` is a
+    /// [`FrameFailure`](crate::FrameFailure) cause and value.
+    FrameFailed,
     /// Any other value.
     Unknown(u16),
 }
@@ -80,6 +88,9 @@ impl From<u16> for ErrorCode {
             0x0002 => ErrorCode::UnknownRegister,
             0x0003 => ErrorCode::UnsupportedVersion,
             0x0004 => ErrorCode::Busy,
+            0x0100 => ErrorCode::InvalidConfig,
+            0x0101 => ErrorCode::UnexpectedKind,
+            0x0102 => ErrorCode::FrameFailed,
             other => ErrorCode::Unknown(other),
         }
     }
@@ -92,6 +103,9 @@ impl From<ErrorCode> for u16 {
             ErrorCode::UnknownRegister => 0x0002,
             ErrorCode::UnsupportedVersion => 0x0003,
             ErrorCode::Busy => 0x0004,
+            ErrorCode::InvalidConfig => 0x0100,
+            ErrorCode::UnexpectedKind => 0x0101,
+            ErrorCode::FrameFailed => 0x0102,
             ErrorCode::Unknown(other) => other,
         }
     }
@@ -180,6 +194,8 @@ mod tests {
         for value in 0..=u16::MAX {
             assert_eq!(u16::from(ErrorCode::from(value)), value);
         }
+        assert_eq!(ErrorCode::from(0x0102), ErrorCode::FrameFailed);
+        assert_eq!(ErrorCode::from(0x0103), ErrorCode::Unknown(0x0103));
     }
 
     #[test]

@@ -1,26 +1,29 @@
-//! The whole packet: a 6-byte header, the payload, and a CRC-32C trailer.
+//! The whole packet: a 7-byte header, the payload, and a CRC-32C trailer.
 //!
 //! ```text
-//!  0        1        2        4              6                6+n        10+n
-//! +--------+--------+--------+--------------+-- ... --+------------------+
-//! |version |  kind  |  seq   | payload len n| payload |  CRC-32C (LE)    |
-//! |   u8   |   u8   | u16 LE |    u16 LE    | n bytes | over bytes 0..6+n|
-//! +--------+--------+--------+--------------+-- ... --+------------------+
+//!  0        1        2        3        5              7                7+n        11+n
+//! +--------+--------+--------+--------+--------------+-- ... --+------------------+
+//! |version |  kind  | source |  seq   | payload len n| payload |  CRC-32C (LE)    |
+//! |   u8   |   u8   |   u8   | u16 LE |    u16 LE    | n bytes | over bytes 0..7+n|
+//! +--------+--------+--------+--------+--------------+-- ... --+------------------+
 //! ```
+//! `seq` counts the packets of `source` alone (see [`Source`]).
 
 use crate::checksum::crc32c;
 use crate::le::{self, Field};
 use crate::packet::check_room;
 use crate::packet::kind::PacketKind;
+use crate::packet::source::Source;
 use crate::Error;
 
 mod field {
     use super::Field;
     pub const VERSION: usize = 0;
     pub const KIND: usize = 1;
-    pub const SEQ: Field = 2..4;
-    pub const PAYLOAD_LEN: Field = 4..6;
-    pub const PAYLOAD: usize = 6;
+    pub const SOURCE: usize = 2;
+    pub const SEQ: Field = 3..5;
+    pub const PAYLOAD_LEN: Field = 5..7;
+    pub const PAYLOAD: usize = 7;
 }
 
 /// Bytes before the payload.
@@ -53,7 +56,12 @@ impl<T: AsRef<[u8]>> Packet<T> {
         PacketKind::from(le::read_u8(self.buffer.as_ref(), field::KIND))
     }
 
-    /// Sequence number; the sender increments it (wrapping) per packet, so gaps show loss.
+    /// Which sender of its end wrote the packet.
+    pub fn source(&self) -> Source {
+        Source::from(le::read_u8(self.buffer.as_ref(), field::SOURCE))
+    }
+
+    /// Sequence number; the source increments it (wrapping) per packet, so gaps show loss.
     pub fn seq(&self) -> u16 {
         le::read_u16(self.buffer.as_ref(), field::SEQ)
     }
@@ -93,6 +101,11 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
         le::write_u8(self.buffer.as_mut(), field::KIND, u8::from(value));
     }
 
+    /// Sets the source.
+    pub fn set_source(&mut self, value: Source) {
+        le::write_u8(self.buffer.as_mut(), field::SOURCE, u8::from(value));
+    }
+
     /// Sets the sequence number.
     pub fn set_seq(&mut self, value: u16) {
         le::write_u16(self.buffer.as_mut(), field::SEQ, value);
@@ -127,7 +140,9 @@ pub struct Header {
     pub version: u8,
     /// Packet kind.
     pub kind: PacketKind,
-    /// Sequence number.
+    /// Which sender of its end wrote the packet.
+    pub source: Source,
+    /// Sequence number, counted per source.
     pub seq: u16,
     /// Payload length in bytes.
     pub payload_len: u16,
@@ -141,6 +156,7 @@ impl Header {
         Ok(Header {
             version: packet.version(),
             kind: packet.kind(),
+            source: packet.source(),
             seq: packet.seq(),
             payload_len: packet.payload_len(),
         })
@@ -156,6 +172,7 @@ impl Header {
         check_room(packet.buffer.as_ref().len(), self.buffer_len())?;
         packet.set_version(self.version);
         packet.set_kind(self.kind);
+        packet.set_source(self.source);
         packet.set_seq(self.seq);
         packet.set_payload_len(self.payload_len);
         Ok(())
@@ -166,19 +183,22 @@ impl Header {
 mod tests {
     use super::*;
 
-    /// The `register_read` vector of the spec: RegisterRead of 0x0104, seq 3.
-    static PACKET_BYTES: [u8; 12] = [
-        0x01, // version 1
+    /// The `register_read` vector of the spec: RegisterRead of 0x0104, from the host's
+    /// control source, seq 3.
+    static PACKET_BYTES: [u8; 13] = [
+        0x02, // version 2
         0x03, // kind RegisterRead
+        0x00, // source Control
         0x03, 0x00, // seq 3
         0x02, 0x00, // payload_len 2
         0x04, 0x01, // payload: addr 0x0104
-        0x71, 0xb0, 0x2b, 0x4a, // CRC-32C 0x4a2bb071
+        0x2f, 0x3f, 0x0a, 0xba, // CRC-32C 0xba0a3f2f
     ];
 
     const HEADER: Header = Header {
-        version: 1,
+        version: 2,
         kind: PacketKind::RegisterRead,
+        source: Source::Control,
         seq: 3,
         payload_len: 2,
     };
@@ -186,21 +206,23 @@ mod tests {
     #[test]
     fn deconstruct() {
         let packet = Packet::new_checked(&PACKET_BYTES[..]).unwrap();
-        assert_eq!(packet.version(), 1);
+        assert_eq!(packet.version(), 2);
         assert_eq!(packet.kind(), PacketKind::RegisterRead);
+        assert_eq!(packet.source(), Source::Control);
         assert_eq!(packet.seq(), 3);
         assert_eq!(packet.payload_len(), 2);
         assert_eq!(packet.payload(), &[0x04, 0x01]);
-        assert_eq!(packet.crc(), 0x4a2b_b071);
+        assert_eq!(packet.crc(), 0xba0a_3f2f);
         assert!(packet.verify_crc());
     }
 
     #[test]
     fn construct() {
-        let mut bytes = [0xa5u8; 12];
+        let mut bytes = [0xa5u8; 13];
         let mut packet = Packet::new_unchecked(&mut bytes[..]);
-        packet.set_version(1);
+        packet.set_version(2);
         packet.set_kind(PacketKind::RegisterRead);
+        packet.set_source(Source::Control);
         packet.set_seq(3);
         packet.set_payload_len(2);
         packet.payload_mut().copy_from_slice(&[0x04, 0x01]);
@@ -217,7 +239,7 @@ mod tests {
 
     #[test]
     fn emit() {
-        let mut bytes = [0u8; 12];
+        let mut bytes = [0u8; 13];
         let mut packet = Packet::new_unchecked(&mut bytes[..]);
         HEADER.emit(&mut packet).unwrap();
         packet.payload_mut().copy_from_slice(&[0x04, 0x01]);
@@ -237,20 +259,20 @@ mod tests {
     #[test]
     fn impossible_length() {
         assert_eq!(
-            Packet::new_checked(&PACKET_BYTES[..9]).unwrap_err(),
+            Packet::new_checked(&PACKET_BYTES[..10]).unwrap_err(),
             Error::DecodeUnexpectedEnd
         );
         assert_eq!(
-            Packet::new_checked(&PACKET_BYTES[..11]).unwrap_err(),
+            Packet::new_checked(&PACKET_BYTES[..12]).unwrap_err(),
             Error::DecodeUnexpectedEnd
         );
-        let mut long = [0u8; 13];
-        long[..12].copy_from_slice(&PACKET_BYTES);
+        let mut long = [0u8; 14];
+        long[..13].copy_from_slice(&PACKET_BYTES);
         assert_eq!(
             Packet::new_checked(&long[..]).unwrap_err(),
             Error::DecodeBadLength
         );
-        let mut short = [0u8; 11];
+        let mut short = [0u8; 12];
         assert_eq!(
             HEADER.emit(&mut Packet::new_unchecked(&mut short[..])),
             Err(Error::EncodeBufferTooSmall)
