@@ -11,8 +11,8 @@ use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use stereocal_wire::{
-    crc32c, decode, encode, max_frame_len, Camera, PacketRepr, Records, SobelPixel, SobelRowsRepr,
-    Source, MAX_SOBEL_ROW_WIDTH,
+    crc32c, decode, encode, max_encoded_len, Camera, PacketRepr, Records, SobelPixel,
+    SobelRowsRepr, Source, MAX_SOBEL_ROW_WIDTH,
 };
 
 const WIDTH: usize = 1264;
@@ -54,7 +54,7 @@ fn repr(y: usize, pixels: &[SobelPixel]) -> PacketRepr<'_> {
 
 /// Every row encoded into one frame each.
 fn frames(rows: &[Vec<SobelPixel>]) -> Vec<Vec<u8>> {
-    let mut buf = vec![0u8; max_frame_len(11 + 2 * MAX_SOBEL_ROW_WIDTH)];
+    let mut buf = vec![0u8; max_encoded_len(11 + 2 * MAX_SOBEL_ROW_WIDTH)];
     rows.iter()
         .enumerate()
         .map(|(y, pixels)| {
@@ -125,7 +125,7 @@ fn bench(c: &mut Criterion) {
         "{ROWS} rows of {WIDTH} pixels: {packet_bytes} packet bytes ({:.0}% zero), {frame_bytes} frame bytes",
         100.0 * zeros as f64 / packet_bytes as f64
     );
-    let mut buf = vec![0u8; max_frame_len(11 + 2 * MAX_SOBEL_ROW_WIDTH)];
+    let mut buf = vec![0u8; max_encoded_len(11 + 2 * MAX_SOBEL_ROW_WIDTH)];
     let mut scratch = buf.clone();
 
     let mut g = c.benchmark_group("framing");

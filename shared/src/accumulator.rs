@@ -3,7 +3,7 @@
 use heapless::Vec;
 
 use crate::cobs_in_place::first_zero;
-use crate::frame::{decode_zero_free, Rejected, DELIMITER};
+use crate::framing::{decode_zero_free, Rejected, DELIMITER};
 use crate::packet::header::Header;
 use crate::packet_repr::PacketRepr;
 use crate::Error;
@@ -14,8 +14,8 @@ const _: () = assert!(DELIMITER == 0);
 /// Collects the bytes of one COBS frame in a buffer of `N` bytes and decodes it when its
 /// `0x00` arrives.
 ///
-/// With `N` = [`MAX_FRAME_LEN`](crate::MAX_FRAME_LEN) (the alias
-/// [`FrameAccumulator`](crate::FrameAccumulator)) every packet kind fits (`MAX_FRAME_LEN - 1`
+/// With `N` = [`MAX_ENCODED_LEN`](crate::MAX_ENCODED_LEN) (the alias
+/// [`FrameAccumulator`](crate::FrameAccumulator)) every packet kind fits (`MAX_ENCODED_LEN - 1`
 /// would do: the delimiter is not stored); a smaller `N` suits a receiver that only expects
 /// short packets, such as the firmware's command input. A frame longer than
 /// `N` is reported once as [`FeedResult::OverFull`] and skipped up to its delimiter, so the

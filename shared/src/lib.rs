@@ -5,11 +5,11 @@
 //!
 //! # Sending (firmware)
 //! Build a [`PacketRepr`] and [`encode`] it into a buffer you own; the result is one complete
-//! frame, delimiter included, ready for the UART:
+//! link frame (the encoded packet, delimiter included), ready for the UART:
 //! ```
-//! use stereocal_wire::{encode, Camera, FrameStartRepr, PacketRepr, Source, MAX_FRAME_LEN};
+//! use stereocal_wire::{encode, Camera, FrameStartRepr, PacketRepr, Source, MAX_ENCODED_LEN};
 //!
-//! let mut buf = [0u8; MAX_FRAME_LEN];
+//! let mut buf = [0u8; MAX_ENCODED_LEN];
 //! let repr = PacketRepr::FrameStart(FrameStartRepr {
 //!     frame_id: 1,
 //!     camera: Camera::Left,
@@ -65,7 +65,7 @@ mod accumulator;
 mod checksum;
 mod cobs_in_place;
 mod error;
-mod frame;
+mod framing;
 mod geometry;
 mod le;
 mod packet_repr;
@@ -74,7 +74,7 @@ mod records;
 pub use accumulator::{Accumulator, FeedResult};
 pub use checksum::crc32c;
 pub use error::Error;
-pub use frame::{decode, encode, max_frame_len, DELIMITER};
+pub use framing::{decode, encode, max_encoded_len, DELIMITER};
 pub use geometry::octave_dims;
 pub use packet::camera::Camera;
 pub use packet::encoders::EncodersRepr;
@@ -156,12 +156,12 @@ pub const MAX_PAYLOAD_LEN: usize = {
 };
 /// Largest packet (header, payload, CRC) before COBS.
 pub const MAX_PACKET_LEN: usize = HEADER_LEN + MAX_PAYLOAD_LEN + CRC_LEN;
-/// Largest frame on the wire (COBS bytes and delimiter); sizes every transmit buffer and
+/// Largest link frame (an encoded packet: COBS bytes and delimiter); sizes every transmit buffer and
 /// every [`Accumulator`] that must receive all kinds.
-pub const MAX_FRAME_LEN: usize = max_frame_len(MAX_PAYLOAD_LEN);
+pub const MAX_ENCODED_LEN: usize = max_encoded_len(MAX_PAYLOAD_LEN);
 
 /// An accumulator that receives every packet kind.
-pub type FrameAccumulator = Accumulator<MAX_FRAME_LEN>;
+pub type FrameAccumulator = Accumulator<MAX_ENCODED_LEN>;
 
 // The header's payload length field is a u16.
 const _: () = assert!(MAX_PAYLOAD_LEN <= u16::MAX as usize);

@@ -1,11 +1,11 @@
 //! The bandwidth table of `docs/wire-format.md`, recomputed from the packet layouts.
 //!
-//! Frame sizes are the COBS worst case ([`max_frame_len`]), so the table is an upper bound.
+//! Frame sizes are the COBS worst case ([`max_encoded_len`]), so the table is an upper bound.
 //! The scene: one 640x480 camera frame, 4 octaves (each half the size of the one before),
 //! 500 keypoints.
 
 use stereocal_wire::{
-    max_frame_len, Camera, FrameEndRepr, FrameStartRepr, PacketRepr, PointBatchRepr, Records,
+    max_encoded_len, Camera, FrameEndRepr, FrameStartRepr, PacketRepr, PointBatchRepr, Records,
     SobelPatchRepr, SobelPixel, SobelRowsRepr, MAX_POINTS, PATCH_PIXELS,
 };
 
@@ -19,7 +19,7 @@ const SCALES: usize = 4;
 const PAIRS_PER_SECOND: usize = 30;
 
 fn frame_len(repr: PacketRepr<'_>) -> usize {
-    max_frame_len(repr.buffer_len())
+    max_encoded_len(repr.buffer_len())
 }
 
 /// FrameStart, the point batches and FrameEnd: sent in every mode.

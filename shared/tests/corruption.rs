@@ -8,11 +8,11 @@ use proptest::collection::vec;
 use proptest::prelude::*;
 use stereocal_wire::{
     crc32c, decode, encode, Accumulator, Error, FeedResult, Header, HelloRepr, PacketKind,
-    PacketRepr, RegisterReadRepr, Source, CRC_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
+    PacketRepr, RegisterReadRepr, Source, CRC_LEN, MAX_ENCODED_LEN, PROTOCOL_VERSION,
 };
 
 fn encoded(seq: u16, packet: &PacketRepr<'_>) -> Vec<u8> {
-    let mut buf = [0u8; MAX_FRAME_LEN];
+    let mut buf = [0u8; MAX_ENCODED_LEN];
     encode(Source::Control, seq, packet, &mut buf)
         .expect("valid packets encode")
         .to_vec()
@@ -98,7 +98,7 @@ proptest! {
         }
         prop_assume!(damaged != encoded(1, &packet.repr()));
         let stream = [encoded(0, &marker(0xa)), damaged, encoded(2, &marker(0xb))].concat();
-        let outcome = run::<MAX_FRAME_LEN>(&stream);
+        let outcome = run::<MAX_ENCODED_LEN>(&stream);
         prop_assert_eq!(&outcome.packets, &vec![(0, marker(0xa)), (2, marker(0xb))]);
         prop_assert!(!outcome.errors.is_empty());
     }
@@ -117,7 +117,7 @@ proptest! {
             encoded(3, &marker(0xc)),
         ]
         .concat();
-        let outcome = run::<MAX_FRAME_LEN>(&stream);
+        let outcome = run::<MAX_ENCODED_LEN>(&stream);
         prop_assert_eq!(outcome.packets.first(), Some(&(0, marker(0xa))));
         prop_assert_eq!(outcome.packets.last(), Some(&(3, marker(0xc))));
     }
@@ -133,7 +133,7 @@ proptest! {
             encoded(3, &marker(0xc)),
         ]
         .concat();
-        let outcome = run::<MAX_FRAME_LEN>(&stream);
+        let outcome = run::<MAX_ENCODED_LEN>(&stream);
         prop_assert_eq!(outcome.packets.first(), Some(&(0, marker(0xa))));
         prop_assert_eq!(outcome.packets.last(), Some(&(3, marker(0xc))));
         for middle in &outcome.packets[1..outcome.packets.len() - 1] {
@@ -147,7 +147,7 @@ proptest! {
     /// Arbitrary bytes never panic the accumulator or `decode`, whatever the buffer size.
     #[test]
     fn arbitrary_bytes_never_panic(bytes in vec(any::<u8>(), 0..4000)) {
-        run::<MAX_FRAME_LEN>(&bytes);
+        run::<MAX_ENCODED_LEN>(&bytes);
         run::<16>(&bytes);
         let mut copy = bytes.clone();
         let _ = decode(&mut copy);
@@ -255,7 +255,7 @@ fn an_intact_header_comes_with_the_error() {
         damaged,
     ]
     .concat();
-    let mut acc = Accumulator::<MAX_FRAME_LEN>::new();
+    let mut acc = Accumulator::<MAX_ENCODED_LEN>::new();
     let mut window = &stream[..];
     let mut seen = Vec::new();
     while let FeedResult::DecodeError {
@@ -329,7 +329,7 @@ fn overlong_frame_is_reported_once_and_skipped() {
 fn lone_delimiters_are_idle_and_flush_a_partial_frame() {
     let frame = encoded(5, &marker(0xb));
     let stream = [&[0u8, 0, 0][..], &frame[..3], &[0], &frame, &[0, 0]].concat();
-    let outcome = run::<MAX_FRAME_LEN>(&stream);
+    let outcome = run::<MAX_ENCODED_LEN>(&stream);
     assert_eq!(outcome.packets, vec![(5, marker(0xb))]);
     assert_eq!(outcome.errors.len(), 1);
 }

@@ -7,12 +7,12 @@ use arbitrary::{packet, OwnedPacket};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use stereocal_wire::{
-    decode, encode, max_frame_len, Accumulator, FeedResult, PacketRepr, Source, CRC_LEN,
-    HEADER_LEN, MAX_FRAME_LEN, PROTOCOL_VERSION,
+    decode, encode, max_encoded_len, Accumulator, FeedResult, PacketRepr, Source, CRC_LEN,
+    HEADER_LEN, MAX_ENCODED_LEN, PROTOCOL_VERSION,
 };
 
 fn encoded(source: Source, seq: u16, packet: &OwnedPacket) -> Vec<u8> {
-    let mut buf = [0u8; MAX_FRAME_LEN];
+    let mut buf = [0u8; MAX_ENCODED_LEN];
     encode(source, seq, &packet.repr(), &mut buf)
         .expect("valid packets encode")
         .to_vec()
@@ -26,7 +26,7 @@ proptest! {
         let repr = packet.repr();
         let source = Source::from(source);
         let mut frame = encoded(source, seq, &packet);
-        prop_assert!(frame.len() <= max_frame_len(repr.buffer_len()));
+        prop_assert!(frame.len() <= max_encoded_len(repr.buffer_len()));
         prop_assert_eq!(frame.last(), Some(&0));
         prop_assert!(!frame[..frame.len() - 1].contains(&0));
 
@@ -58,7 +58,7 @@ proptest! {
     ) {
         let stream: Vec<u8> =
             packets.iter().enumerate().flat_map(|(seq, p)| encoded(Source::Right, seq as u16, p)).collect();
-        let mut acc = Accumulator::<MAX_FRAME_LEN>::new();
+        let mut acc = Accumulator::<MAX_ENCODED_LEN>::new();
         let mut received = 0usize;
         let mut offset = 0;
         let mut sizes = chunk_sizes.iter().cycle();
@@ -86,7 +86,7 @@ proptest! {
 #[test]
 fn short_output_buffer_is_an_error() {
     let repr = PacketRepr::RegisterRead(stereocal_wire::RegisterReadRepr { addr: 1 });
-    let needed = max_frame_len(repr.buffer_len());
+    let needed = max_encoded_len(repr.buffer_len());
     let mut buf = vec![0u8; needed - 1];
     assert_eq!(
         encode(Source::Control, 0, &repr, &mut buf),
@@ -112,9 +112,9 @@ fn max_frame_len_covers_the_largest_packet() {
         pixels: stereocal_wire::Records::Values(&pixels),
     });
     assert_eq!(repr.buffer_len(), stereocal_wire::MAX_PAYLOAD_LEN);
-    let mut buf = [0u8; MAX_FRAME_LEN];
+    let mut buf = [0u8; MAX_ENCODED_LEN];
     let frame = encode(Source::Unknown(0xff), 0xffff, &repr, &mut buf).unwrap();
-    assert!(frame.len() <= MAX_FRAME_LEN);
+    assert!(frame.len() <= MAX_ENCODED_LEN);
     let mut frame = frame.to_vec();
     assert_eq!(decode(&mut frame).unwrap().1, repr);
 }
@@ -141,7 +141,7 @@ fn long_nonzero_runs_encode_like_the_cobs_crate() {
             pixels: stereocal_wire::Records::Values(&bright[..len + 100]),
         });
         for repr in [log, rows] {
-            let mut buf = [0u8; MAX_FRAME_LEN];
+            let mut buf = [0u8; MAX_ENCODED_LEN];
             let mut frame = encode(Source::Unknown(0xff), 0xffff, &repr, &mut buf)
                 .unwrap()
                 .to_vec();

@@ -20,7 +20,7 @@ use stereocal_wire::{
     decode, encode, Camera, Capabilities, EncodersRepr, ErrorCode, ErrorReportRepr, FrameEndFlags,
     FrameEndRepr, FrameStartRepr, HelloRepr, LogRepr, PacketRepr, Point, PointBatchRepr, Records,
     RegisterReadRepr, RegisterValueRepr, RegisterWriteRepr, SobelPatchRepr, SobelPixel,
-    SobelRowsRepr, Source, MAX_FRAME_LEN, PATCH_PIXELS,
+    SobelRowsRepr, Source, MAX_ENCODED_LEN, PATCH_PIXELS,
 };
 
 const SPEC: &str = include_str!("../docs/wire-format.md");
@@ -310,7 +310,7 @@ fn render(name: &str, block: &Block) -> String {
 }
 
 fn encoded(source: Source, seq: u16, repr: &PacketRepr<'_>) -> Block {
-    let mut buf = [0u8; MAX_FRAME_LEN];
+    let mut buf = [0u8; MAX_ENCODED_LEN];
     let frame = encode(source, seq, repr, &mut buf)
         .expect("vector encodes")
         .to_vec();

@@ -6,7 +6,7 @@
 //! packets ([`Numbering`]) and writes them through the same writer, so the host sees a gap in
 //! any one source.
 
-use stereocal_wire::{encode, PacketRepr, Source, MAX_FRAME_LEN};
+use stereocal_wire::{encode, PacketRepr, Source, MAX_ENCODED_LEN};
 
 use crate::driver::numbering::Numbering;
 
@@ -29,7 +29,7 @@ impl<S: ByteSink + ?Sized> ByteSink for &mut S {
 pub struct PacketWriter<S: ByteSink> {
     sink: S,
     control: Numbering,
-    frame: [u8; MAX_FRAME_LEN],
+    frame: [u8; MAX_ENCODED_LEN],
 }
 
 impl<S: ByteSink> PacketWriter<S> {
@@ -38,7 +38,7 @@ impl<S: ByteSink> PacketWriter<S> {
         Self {
             sink,
             control: Numbering::new(Source::Control),
-            frame: [0; MAX_FRAME_LEN],
+            frame: [0; MAX_ENCODED_LEN],
         }
     }
 
@@ -87,7 +87,7 @@ impl<S: ByteSink> PacketWriter<S> {
 /// up only when the packet was encoded, so a refused packet leaves no gap.
 fn write<S: ByteSink>(
     sink: &mut S,
-    frame: &mut [u8; MAX_FRAME_LEN],
+    frame: &mut [u8; MAX_ENCODED_LEN],
     numbering: &mut Numbering,
     packet: &PacketRepr<'_>,
 ) -> Result<(), stereocal_wire::Error> {

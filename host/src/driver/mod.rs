@@ -36,7 +36,7 @@ use std::time::{Duration, Instant};
 use stereocal_hdl::{FabricConfig, Registers};
 use stereocal_wire::{
     encode, Accumulator, Camera, EncodersRepr, ErrorReportRepr, FeedResult, HelloRepr, PacketRepr,
-    RegisterReadRepr, RegisterWriteRepr, Source, MAX_FRAME_LEN, PROTOCOL_VERSION,
+    RegisterReadRepr, RegisterWriteRepr, Source, MAX_ENCODED_LEN, PROTOCOL_VERSION,
 };
 
 pub use assembler::{DamagedFrame, FrameOutcome, LogFrame, ReceivedFrame};
@@ -121,7 +121,7 @@ pub struct DeviceReport {
 /// The host driver over a link `L`.
 pub struct Driver<L: Link> {
     link: L,
-    accumulator: Box<Accumulator<{ MAX_FRAME_LEN - 1 }>>,
+    accumulator: Box<Accumulator<{ MAX_ENCODED_LEN - 1 }>>,
     rx: Vec<u8>,
     rx_pos: usize,
     rx_len: usize,
@@ -150,7 +150,7 @@ impl<L: Link> Driver<L> {
             rx_len: 0,
             wire_pending: 0,
             assembler: FrameAssembler::default(),
-            tx: vec![0; MAX_FRAME_LEN],
+            tx: vec![0; MAX_ENCODED_LEN],
             tx_seq: 0,
             frames: VecDeque::new(),
             pending_pair: None,

@@ -24,7 +24,7 @@ use stereocal_firmware::driver::{
 use stereocal_firmware::fabric::{FabricDevice, FabricModel};
 use stereocal_hdl::regs::control;
 use stereocal_hdl::RegisterBus;
-use stereocal_wire::{Accumulator, Camera, EncodersRepr, FeedResult, PacketRepr, MAX_FRAME_LEN};
+use stereocal_wire::{Accumulator, Camera, EncodersRepr, FeedResult, PacketRepr, MAX_ENCODED_LEN};
 
 use super::{Link, LinkError};
 
@@ -87,7 +87,7 @@ pub struct InProcessLink {
     /// from pair to pair for their allocations. Only their sinks and frame buffers are used:
     /// the channels number their own packets.
     pair_out: [PacketWriter<Outbox>; 2],
-    inbox: Box<Accumulator<{ MAX_FRAME_LEN - 1 }>>,
+    inbox: Box<Accumulator<{ MAX_ENCODED_LEN - 1 }>>,
 }
 
 impl InProcessLink {

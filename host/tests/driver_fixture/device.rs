@@ -5,8 +5,8 @@ use std::io::{ErrorKind, Read, Write};
 
 use stereocal_hdl::{regs, RegisterBank, RegisterBus};
 use stereocal_wire::{
-    Accumulator, Capabilities, FeedResult, HelloRepr, PacketRepr, RegisterValueRepr, MAX_FRAME_LEN,
-    PROTOCOL_VERSION,
+    Accumulator, Capabilities, FeedResult, HelloRepr, PacketRepr, RegisterValueRepr,
+    MAX_ENCODED_LEN, PROTOCOL_VERSION,
 };
 
 use super::{FrameSpec, Wire};
@@ -16,7 +16,7 @@ pub fn serve(stream: &mut (impl Read + Write), frames: &[FrameSpec]) -> usize {
     let mut wire = Wire::new();
     let mut sent = 0;
     let mut received = 0;
-    let mut acc = Accumulator::<{ MAX_FRAME_LEN - 1 }>::new();
+    let mut acc = Accumulator::<{ MAX_ENCODED_LEN - 1 }>::new();
     let mut bank = RegisterBank::new();
     let mut buf = [0u8; 4096];
     loop {

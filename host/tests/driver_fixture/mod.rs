@@ -12,7 +12,7 @@ use std::ops::Range;
 use stereocal_wire::{
     encode, octave_dims, Camera, FrameEndFlags, FrameEndRepr, FrameStartRepr, LogRepr, PacketRepr,
     Point, PointBatchRepr, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, Source,
-    MAX_FRAME_LEN, MAX_POINTS, PATCH_PIXELS,
+    MAX_ENCODED_LEN, MAX_POINTS, PATCH_PIXELS,
 };
 
 /// The Sobel pixel the fixture sends at octave pixel `(x, y)` of `octave`.
@@ -118,7 +118,7 @@ impl Wire {
 
     /// Encodes `packet` with the next sequence number of its source.
     pub fn push(&mut self, packet: &PacketRepr<'_>) -> Range<usize> {
-        let mut buf = [0u8; MAX_FRAME_LEN];
+        let mut buf = [0u8; MAX_ENCODED_LEN];
         let source = source_of(packet);
         let seq = self.take_seq(source);
         let frame = encode(source, seq, packet, &mut buf).expect("fixture packets encode");
@@ -131,7 +131,7 @@ impl Wire {
 
     /// A packet the device numbered but the link lost.
     pub fn lose(&mut self, packet: &PacketRepr<'_>) {
-        let mut buf = [0u8; MAX_FRAME_LEN];
+        let mut buf = [0u8; MAX_ENCODED_LEN];
         let source = source_of(packet);
         let seq = self.take_seq(source);
         encode(source, seq, packet, &mut buf).expect("fixture packets encode");

@@ -442,7 +442,7 @@ pub fn markdown(sweep: &Sweep, command: &str) -> String {
          Nothing on the receiving side grows with the faults. The fault link holds at most \
          one receive of the wrapped link (64 KiB), a partial packet, a duplicate and one \
          held-back packet: the column above, about the same at every rate. The driver's accumulator is a fixed \
-         `MAX_FRAME_LEN` buffer that skips an over-long frame rather than growing, its receive \
+         `MAX_ENCODED_LEN` buffer that skips an over-long frame rather than growing, its receive \
          buffer is a fixed 64 KiB, the assembler holds one frame in progress (its Sobel planes \
          sized by the `FrameStart` geometry, which is checked against the fabric's maximum \
          before anything is allocated; a damaged frame stops collecting points and rows at its \

@@ -10,7 +10,7 @@
 use libfuzzer_sys::fuzz_target;
 use stereocal_wire::{
     decode, encode, Accumulator, FeedResult, PacketRepr, RegisterReadRepr, Source, DELIMITER,
-    MAX_FRAME_LEN,
+    MAX_ENCODED_LEN,
 };
 
 const MARKER_SEQ: u16 = 0xBEEF;
@@ -27,7 +27,7 @@ fn feed_all<const N: usize>(acc: &mut Accumulator<N>, mut window: &[u8]) {
                 packet,
                 remaining,
             } => {
-                let mut buf = [0u8; MAX_FRAME_LEN];
+                let mut buf = [0u8; MAX_ENCODED_LEN];
                 let frame = encode(header.source, header.seq, &packet, &mut buf)
                     .expect("a decoded packet re-encodes");
                 let mut frame = frame.to_vec();
@@ -60,14 +60,14 @@ fn resyncs<const N: usize>(acc: &mut Accumulator<N>, marker_frame: &[u8]) {
 }
 
 fuzz_target!(|data: &[u8]| {
-    let mut marker_buf = [0u8; MAX_FRAME_LEN];
+    let mut marker_buf = [0u8; MAX_ENCODED_LEN];
     let marker_frame =
         encode(Source::Control, MARKER_SEQ, &MARKER, &mut marker_buf).expect("the marker encodes");
 
     let split = data.first().map_or(0, |&b| usize::from(b)).min(data.len());
     let (head, tail) = data.split_at(split);
 
-    let mut full = Accumulator::<MAX_FRAME_LEN>::new();
+    let mut full = Accumulator::<MAX_ENCODED_LEN>::new();
     feed_all(&mut full, head);
     feed_all(&mut full, tail);
     resyncs(&mut full, marker_frame);

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use defmt_decoder::Table;
 use stereocal_firmware::softcore::instructions::{InstructionReport, KernelReport};
-use stereocal_wire::{Accumulator, FeedResult, PacketRepr, MAX_FRAME_LEN};
+use stereocal_wire::{Accumulator, FeedResult, PacketRepr, MAX_ENCODED_LEN};
 
 use super::HilError;
 
@@ -59,7 +59,7 @@ impl LogDecoder {
     /// Every `Log` packet in `transcript` (device-to-host bytes), decoded, in order. Damaged
     /// link frames are skipped: the host driver counts those.
     pub fn logs(&self, transcript: &[u8]) -> Vec<DeviceLog> {
-        let mut accumulator = Box::new(Accumulator::<{ MAX_FRAME_LEN - 1 }>::new());
+        let mut accumulator = Box::new(Accumulator::<{ MAX_ENCODED_LEN - 1 }>::new());
         let mut logs = Vec::new();
         let mut window = transcript;
         while !window.is_empty() {

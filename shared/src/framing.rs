@@ -1,6 +1,8 @@
-//! Framing: a packet (header, payload, CRC-32C) COBS-encoded and terminated by `0x00`.
+//! Framing: a packet (header, payload, CRC-32C) COBS-encoded and terminated by `0x00`, a
+//! *link frame*. (A bare "frame" in this project is a camera frame; the link's unit is always
+//! called a link frame or an encoded packet.)
 //!
-//! COBS removes every `0x00` from the packet bytes, so `0x00` marks frame ends only and a
+//! COBS removes every `0x00` from the packet bytes, so `0x00` marks link-frame ends only and a
 //! receiver that lost sync (a dropped byte, line noise, a reset peer) is back in step at the
 //! next `0x00`. The overhead is one byte per 254 bytes plus one, and the delimiter.
 
@@ -15,15 +17,15 @@ pub const DELIMITER: u8 = 0x00;
 
 /// Longest frame (COBS bytes plus the delimiter) a packet with `payload_len` payload bytes
 /// can take; `encode` needs an output buffer at least this long.
-pub const fn max_frame_len(payload_len: usize) -> usize {
+pub const fn max_encoded_len(payload_len: usize) -> usize {
     cobs::max_encoding_length(HEADER_LEN + payload_len + CRC_LEN) + 1
 }
 
 /// Encodes `repr` as packet `seq` of `source` into `out` as one complete frame, delimiter
 /// included, and returns the frame (a prefix of `out`).
 ///
-/// `out` must hold [`max_frame_len`]`(repr.buffer_len())` bytes (at most
-/// [`MAX_FRAME_LEN`](crate::MAX_FRAME_LEN)), even when the frame turns out shorter: the packet
+/// `out` must hold [`max_encoded_len`]`(repr.buffer_len())` bytes (at most
+/// [`MAX_ENCODED_LEN`](crate::MAX_ENCODED_LEN)), even when the frame turns out shorter: the packet
 /// is first written one byte in, behind the slot of the first COBS code byte, and then
 /// COBS-encoded in place, so no second buffer is needed on the soft-core. Mostly that only
 /// rewrites its zeros; a packet with full COBS blocks (254 non-zero bytes) first moves one
@@ -38,7 +40,7 @@ pub fn encode<'o>(
     if payload_len > MAX_PAYLOAD_LEN {
         return Err(Error::EncodeTooManyRecords);
     }
-    if out.len() < max_frame_len(payload_len) {
+    if out.len() < max_encoded_len(payload_len) {
         return Err(Error::EncodeBufferTooSmall);
     }
     let packet_len = HEADER_LEN + payload_len + CRC_LEN;
@@ -58,7 +60,7 @@ pub fn encode<'o>(
     header.emit(&mut packet)?;
     repr.emit(packet.payload_mut())?;
     packet.fill_crc();
-    // `out` holds `max_frame_len` bytes (checked above), so neither `None` below happens.
+    // `out` holds `max_encoded_len` bytes (checked above), so neither `None` below happens.
     let frame_len = cobs_in_place::encode_in_place(out, offset, packet_len)
         .ok_or(Error::EncodeBufferTooSmall)?;
     *out.get_mut(frame_len).ok_or(Error::EncodeBufferTooSmall)? = DELIMITER;
