@@ -76,6 +76,15 @@ impl<T: Copy, const W: usize, const LINES: usize> LineFifo<T, W, LINES> {
         self.clear();
     }
 
+    /// The oldest entry, left in place.
+    #[inline]
+    pub fn peek(&self) -> Option<&T> {
+        if self.len == 0 {
+            return None;
+        }
+        self.mem.as_flattened().get(self.head)
+    }
+
     /// Removes the oldest entry.
     #[inline]
     pub fn pop(&mut self) -> Option<T> {

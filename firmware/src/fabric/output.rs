@@ -148,19 +148,11 @@ impl<const W0: usize> OutputFifos<W0> {
         }
     }
 
-    /// Enqueues a row of Sobel pixels `(i, y)` of `octave`; what does not fit is counted.
+    /// Enqueues the pixels of `run`, oldest first; what does not fit is counted.
     #[inline]
-    pub fn push_sobel_row(&mut self, octave: u8, y: u16, magnitude: &[u8], orientation: &[u8]) {
-        let n = magnitude.len().min(orientation.len());
-        let row = SobelRun {
-            octave,
-            y,
-            x: 0,
-            magnitude,
-            orientation,
-        };
-        let fit = self.sobel.push_run(row);
-        self.overflow.sobel = self.overflow.sobel.saturating_add((n - fit) as u32);
+    pub fn push_sobel_run(&mut self, run: SobelRun<'_>) {
+        let fit = self.sobel.push_run(run);
+        self.overflow.sobel = self.overflow.sobel.saturating_add((run.len() - fit) as u32);
     }
 
     /// Hands all queued points to `sink` (at most two slices) and empties the FIFO.

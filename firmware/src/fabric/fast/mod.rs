@@ -8,7 +8,9 @@
 mod filter;
 mod frontend;
 mod octave;
+mod pending;
 mod probe;
+mod release;
 #[cfg(target_arch = "x86_64")]
 mod simd;
 
