@@ -31,6 +31,7 @@ pub struct SobelRun<'a> {
 
 impl<'a> SobelRun<'a> {
     /// The run of the one pixel `p`.
+    #[inline]
     pub fn single(p: &'a SobelPixel) -> Self {
         Self {
             octave: p.octave,
@@ -42,16 +43,19 @@ impl<'a> SobelRun<'a> {
     }
 
     /// Pixels in the run.
+    #[inline]
     pub fn len(&self) -> usize {
         self.magnitude.len().min(self.orientation.len())
     }
 
     /// Whether the run has no pixel.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 
     /// The first `n` pixels (all of them if fewer) and the rest.
+    #[inline]
     pub fn split_at(&self, n: usize) -> (Self, Self) {
         let n = n.min(self.len());
         let (m0, m1) = self.magnitude.split_at_checked(n).unwrap_or_default();
@@ -71,6 +75,7 @@ impl<'a> SobelRun<'a> {
     }
 
     /// The pixels, oldest first.
+    #[inline]
     pub fn pixels(&self) -> impl Iterator<Item = SobelPixel> + 'a {
         let (octave, y, x) = (self.octave, self.y, self.x);
         self.magnitude.iter().zip(self.orientation).enumerate().map(
@@ -174,9 +179,30 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     }
 
     /// Enqueues the leading pixels of `run`, as many as fit; returns how many did.
+    #[inline]
     pub fn push_run(&mut self, run: SobelRun<'_>) -> usize {
         let fit = run.len().min(Self::CAPACITY - self.len);
         let at = Self::wrap(self.head + self.len);
+        // The common case, all of it before the end of the rings, byte by byte: runs of one
+        // or two pixels are common (octaves interleave clock by clock), too short for a copy
+        // call.
+        if fit == run.len() && at + fit <= Self::CAPACITY {
+            let rings = (
+                self.magnitude.as_flattened_mut().get_mut(at..at + fit),
+                self.orientation.as_flattened_mut().get_mut(at..at + fit),
+            );
+            if let (Some(magnitude), Some(orientation)) = rings {
+                for (d, &v) in magnitude.iter_mut().zip(run.magnitude) {
+                    *d = v;
+                }
+                for (d, &v) in orientation.iter_mut().zip(run.orientation) {
+                    *d = v;
+                }
+                self.len += fit;
+                self.append(run.octave, run.y, run.x, fit as u16, at);
+                return fit;
+            }
+        }
         // Up to the end of the rings, then from their start.
         let (first, second) = run.split_at(fit).0.split_at(Self::CAPACITY - at);
         let mut written = 0;
@@ -207,6 +233,7 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     /// Records `len` pixels just stored at ring index `at` as pixels `x..` of row `y`: they
     /// extend the newest run when they continue its row and follow it in the rings (not
     /// across their end), else they start a run.
+    #[inline]
     fn append(&mut self, octave: u8, y: u16, x: u16, len: u16, at: usize) {
         if at != 0 && self.run_count > 0 {
             let newest = Self::wrap(self.run_head + self.run_count - 1);

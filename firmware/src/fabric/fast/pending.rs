@@ -45,8 +45,9 @@ pub(crate) struct Pending<const W: usize> {
     orientation: [[u8; W]; SOBEL_ROWS],
     /// Sobel rows computed.
     sobel_rows: u16,
-    /// Raster index of the oldest Sobel pixel not yet handed out.
+    /// Raster index of the oldest Sobel pixel not yet handed out, and its row and column.
     sobel_next: u32,
+    sobel_at: (u16, u16),
     points: LineFifo<Extremum, W, 2>,
     /// The enabled clock after which no candidate of the frame so far occupies the detector
     /// and refinement pipeline.
@@ -68,6 +69,7 @@ impl<const W: usize> Pending<W> {
             orientation: [[0; W]; SOBEL_ROWS],
             sobel_rows: 0,
             sobel_next: 0,
+            sobel_at: (0, 0),
             points: LineFifo::new(Extremum::ZERO),
             candidates_out: 0,
             overruns: 0,
@@ -84,6 +86,7 @@ impl<const W: usize> Pending<W> {
         self.point_latency = octave_to_point(w, self.octave).into();
         self.sobel_rows = 0;
         self.sobel_next = 0;
+        self.sobel_at = (0, 0);
         self.points.clear();
         self.candidates_out = 0;
         self.overruns = 0;
@@ -177,32 +180,21 @@ impl<const W: usize, const W0: usize> Waiting<W0> for Pending<W> {
     fn sobel_run(&self) -> Option<(ClockRun, u32)> {
         let computed = u32::from(self.sobel_rows) * u32::from(self.width);
         let n = self.sobel_next;
-        let row_left = u32::from(self.width).checked_sub(n.checked_rem(self.width.into())?)?;
         if n >= computed {
             return None;
         }
+        let row_left = u32::from(self.width.saturating_sub(self.sobel_at.1));
         let (width, height) = self.frame;
-        let run = enabled_run(
-            width,
-            height,
-            self.octave,
-            u64::from(n) + self.sobel_latency,
-        );
+        let run = enabled_run(width, height, self.octave, u64::from(n) + self.sobel_latency);
         Some((run, row_left.min(computed - n)))
     }
 
     /// Hands the oldest `len` waiting Sobel pixels (of one row) to `out`.
+    #[inline]
     fn release_sobel(&mut self, len: u32, out: &mut OutputFifos<W0>) {
-        let width = u32::from(self.width);
-        let Some((y, x)) = self
-            .sobel_next
-            .checked_div(width)
-            .zip(self.sobel_next.checked_rem(width))
-        else {
-            return;
-        };
-        let slot = y as usize % SOBEL_ROWS;
-        let span = x as usize..(x + len) as usize;
+        let (y, x) = self.sobel_at;
+        let slot = usize::from(y) % SOBEL_ROWS;
+        let span = usize::from(x)..usize::from(x) + len as usize;
         let (Some(magnitude), Some(orientation)) = (
             self.magnitude.get(slot).and_then(|r| r.get(span.clone())),
             self.orientation.get(slot).and_then(|r| r.get(span)),
@@ -211,12 +203,15 @@ impl<const W: usize, const W0: usize> Waiting<W0> for Pending<W> {
         };
         out.push_sobel_run(SobelRun {
             octave: self.octave,
-            y: y as u16,
-            x: x as u16,
+            y,
+            x,
             magnitude,
             orientation,
         });
         self.sobel_next += len;
+        // `len` is at most what is left of the row.
+        let x = x + len as u16;
+        self.sobel_at = if x >= self.width { (y + 1, 0) } else { (y, x) };
     }
 
     /// Clock at which the pipeline pushes the oldest waiting point, or `None` when none waits.

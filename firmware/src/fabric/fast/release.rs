@@ -39,6 +39,7 @@ pub(crate) fn release<const W0: usize>(
 
 /// The position of the oldest of `clocks` before `until`: the lowest clock, the lowest
 /// octave among equal clocks.
+#[inline(always)]
 fn oldest(clocks: impl Iterator<Item = Option<u64>>, until: u64) -> Option<(usize, u64)> {
     let mut first: Option<(usize, u64)> = None;
     for (k, clock) in clocks.enumerate() {
