@@ -142,7 +142,9 @@ impl FifoReader {
                 }
                 *slot += 1;
             }
-            for (o, ((runs, &count), &filled)) in self.runs.iter().zip(&count).zip(&filled).enumerate() {
+            for (o, ((runs, &count), &filled)) in
+                self.runs.iter().zip(&count).zip(&filled).enumerate()
+            {
                 let (Some(magnitude), Some(orientation)) =
                     (self.magnitude.get(o), self.orientation.get(o))
                 else {

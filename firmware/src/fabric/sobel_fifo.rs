@@ -186,6 +186,9 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
         // The common case, all of it before the end of the rings, byte by byte: runs of one
         // or two pixels are common (octaves interleave clock by clock), too short for a copy
         // call.
+        if fit == 0 {
+            return 0;
+        }
         if fit == run.len() && at + fit <= Self::CAPACITY {
             let rings = (
                 self.magnitude.as_flattened_mut().get_mut(at..at + fit),

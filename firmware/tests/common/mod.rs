@@ -88,6 +88,26 @@ pub fn real_image() -> Option<(Vec<u8>, usize, usize)> {
     }
 }
 
+/// The first left frame of the KITTI drive (1241x376) as 8-bit grey, or `None` (with a loud
+/// message) when the data set is absent outside CI. Under `CI=true` its absence is a failure.
+pub fn kitti_image() -> Option<(Vec<u8>, usize, usize)> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/data/real/kitti_odometry_drive/left/000000.png"
+    );
+    if !std::path::Path::new(path).exists() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "KITTI frame missing under CI=true: {path}"
+        );
+        eprintln!("\n!!! SKIPPING KITTI-frame check: {path} not found !!!\n");
+        return None;
+    }
+    let img = image::open(path).expect("KITTI frame decodes").into_luma8();
+    let (w, h) = img.dimensions();
+    Some((img.into_raw(), w as usize, h as usize))
+}
+
 /// Centre crop / pad (by edge replication) of a grey image to `w x h`.
 pub fn fit(img: &[u8], iw: usize, ih: usize, w: usize, h: usize) -> Vec<u8> {
     let (ox, oy) = (

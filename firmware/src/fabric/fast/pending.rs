@@ -185,7 +185,12 @@ impl<const W: usize, const W0: usize> Waiting<W0> for Pending<W> {
         }
         let row_left = u32::from(self.width.saturating_sub(self.sobel_at.1));
         let (width, height) = self.frame;
-        let run = enabled_run(width, height, self.octave, u64::from(n) + self.sobel_latency);
+        let run = enabled_run(
+            width,
+            height,
+            self.octave,
+            u64::from(n) + self.sobel_latency,
+        );
         Some((run, row_left.min(computed - n)))
     }
 
