@@ -1,5 +1,5 @@
 //! The fast path equals the register-level model bit for bit: same points, same Sobel pixels,
-//! per octave in raster order, on random and real images of several sizes.
+//! in the same FIFO order, on random and real images of several sizes.
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! The last rows of every octave's Sobel image, assembled from the fabric's Sobel stream.
 //!
-//! The fabric streams Sobel pixels in raster order within each octave (octaves interleaved).
+//! The fabric streams Sobel pixels in raster order within each octave (octaves interleaved
+//! clock by clock).
 //! The ring keeps the last [`RING_ROWS`] complete rows of each octave: enough for a full row
 //! to be sent as `SobelRows`, or for a 16x16 patch to be cut around a point that arrives up to
 //! `RING_ROWS - 17` rows after the Sobel row it sits on (the fabric's points lag its Sobel rows

@@ -44,9 +44,16 @@
 //! ([`latency::first_pixel_of_last_octave`], checked against the model's clocks by
 //! `tests/latency.rs`), stored once that many clocks have passed.
 //!
+//! # FIFO order
+//! Both FIFOs hold their entries in the RTL's order, whichever datapath is behind the device:
+//! by clock, and within a clock octave 0 first (`sc_out_fifo` takes the four octaves' items
+//! of a clock in octave order). Between line times the FIFO contents, levels and overflow
+//! counters are the register-level model's entry for entry, so a program that reads the
+//! same registers between the same line times pops the same words and sees the same drops
+//! from either datapath (`tests/fifo_order.rs`).
+//!
 //! What a program can observe therefore matches the RTL register for register, but not clock
-//! for clock: when the FIFOs fill within a line, and (with the fast path) the order in which
-//! octaves interleave their entries, follow the datapath's granularity.
+//! for clock: the entries a line time brings arrive together at its end.
 
 use stereocal_hdl::regs::{
     control, frame_count, latency_clocks, point_fifo_data, point_fifo_dsdog, point_fifo_dxdy,

@@ -1,9 +1,10 @@
 //! A datapath chosen at run time: the fast path (the default) or the register-level model.
 //!
-//! Both produce the same points and Sobel pixels; the register-level model is the clock-level
-//! specification of the RTL and is much slower, so the soft-core and the host run the fast
-//! path unless asked otherwise. The two interleave their octaves differently, so the FIFOs
-//! (and the packets of a frame) hold the same entries per octave in a different order.
+//! Both push the same points and Sobel pixels into the FIFOs in the same order, line time by
+//! line time (the RTL's: by clock, octave 0 first within a clock), so the packets of a frame
+//! are the same bytes; the register-level model is the clock-level specification of the RTL
+//! and is much slower, so the soft-core and the host run the fast path unless asked
+//! otherwise.
 
 use crate::fabric::{
     Config, ConfigError, Extremum, FastFrontEnd, FrameError, FrontEnd, Overflow, RegisterFrontEnd,

@@ -13,9 +13,10 @@
 //! 4. `overflow()` tells how many items were dropped because the driver fell behind; the
 //!    counters are never reset silently (only `reset` clears them).
 //!
-//! Within one octave both streams come in raster order; the octaves are interleaved in an
-//! implementation-defined way (the register-level model interleaves them by clock, the fast
-//! path by row), so consumers key on the `octave` field.
+//! Within one octave both streams come in raster order; the octaves interleave as the RTL
+//! pushes them, by clock and octave 0 first within a clock, in both implementations: after
+//! every `push_row` and `blank_row` the FIFOs hold the same entries in the same order and the
+//! counters agree (`tests/fifo_order.rs`).
 
 use crate::fabric::config::{Config, ConfigError};
 use crate::fabric::fifo::LineFifo;

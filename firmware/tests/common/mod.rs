@@ -5,7 +5,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use stereocal_firmware::fabric::{run_frame, Config, Extremum, FrontEnd, Overflow, SobelPixel};
 
-/// Everything a frame produced, each stream stably sorted by octave (raster order kept).
+/// Everything a frame produced, each stream in the order the FIFO gave it.
 #[derive(Debug, PartialEq, Eq)]
 pub struct FrameOut {
     pub points: Vec<Extremum>,
@@ -24,8 +24,6 @@ pub fn run<F: FrontEnd + ?Sized>(fe: &mut F, cfg: &Config, img: &[u8]) -> FrameO
         &mut |s| sobel.extend(s.pixels()),
     )
     .expect("frame runs");
-    points.sort_by_key(|p| p.octave);
-    sobel.sort_by_key(|s| s.octave);
     FrameOut {
         points,
         sobel,
