@@ -13,6 +13,7 @@ fn check(img: &[u8], cfg: &Config, reg: &mut Reg, fast: &mut Fast) -> usize {
     let a = run(reg, cfg, img);
     let b = run(fast, cfg, img);
     assert_eq!(reg.align_errors(), 0, "alignment FIFO fault");
+    assert_eq!(fast.overruns(), 0, "fast path items without room to wait");
     assert_eq!(
         a.overflow.points + a.overflow.sobel,
         0,

@@ -48,7 +48,7 @@ pub(crate) struct Pending<const W: usize> {
     /// Raster index of the oldest Sobel pixel not yet handed out, and its row and column.
     sobel_next: u32,
     sobel_at: (u16, u16),
-    points: LineFifo<Extremum, W, 2>,
+    points: LineFifo<Extremum, W, 1>,
     /// The enabled clock after which no candidate of the frame so far occupies the detector
     /// and refinement pipeline.
     candidates_out: u64,
