@@ -1,6 +1,6 @@
 //! Bounded FIFO over `LINES` line memories of `W` entries (capacity `LINES·W`): the alignment
 //! delays between scale images and the point FIFO the soft-core drains (the Sobel FIFO holds
-//! row runs: `sobel_fifo.rs`). Pushing into a full FIFO hands the value back; the caller
+//! register words: `sobel_fifo.rs`). Pushing into a full FIFO hands the value back; the caller
 //! counts it (nothing is dropped silently).
 //!
 //! Every access goes through `get`/`split_at_mut_checked`: the ring indices are below the

@@ -20,8 +20,9 @@
 
 use crate::fabric::config::{Config, ConfigError};
 use crate::fabric::fifo::LineFifo;
+use crate::fabric::fifo_words::sobel_run_words;
 use crate::fabric::refine::Offset;
-use crate::fabric::sobel_fifo::{SobelFifo, SobelRun};
+use crate::fabric::sobel_fifo::{SobelAppend, SobelFifo, SobelRun};
 
 /// A refined DoG extremum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,11 +150,10 @@ impl<const W0: usize> OutputFifos<W0> {
         }
     }
 
-    /// Enqueues the pixels of `run`, oldest first; what does not fit is counted.
+    /// Something that enqueues Sobel pixels until it is dropped, counting what does not fit.
     #[inline]
-    pub fn push_sobel_run(&mut self, run: SobelRun<'_>) {
-        let fit = self.sobel.push_run(run);
-        self.overflow.sobel = self.overflow.sobel.saturating_add((run.len() - fit) as u32);
+    pub fn append_sobel(&mut self) -> SobelAppend<'_> {
+        self.sobel.append(&mut self.overflow.sobel)
     }
 
     /// Hands all queued points to `sink` (at most two slices) and empties the FIFO.
@@ -165,6 +165,13 @@ impl<const W0: usize> OutputFifos<W0> {
     /// removes them.
     pub fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.sobel.drain(max, sink);
+    }
+
+    /// Copies the words of the oldest `max` queued Sobel pixels (all, and no more than
+    /// `words` holds, if fewer) into `words`, two per pixel, and removes them; returns how
+    /// many pixels.
+    pub fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        self.sobel.drain_words(max, words)
     }
 
     /// Oldest point.
@@ -259,6 +266,19 @@ pub trait FrontEnd {
     /// Hands the oldest `max` queued Sobel pixels (all, if fewer) to `sink`, oldest first, in
     /// runs of consecutive pixels of one row, and removes them.
     fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>));
+    /// Writes the register words of the oldest `max` queued Sobel pixels (all, and no more
+    /// than `words` holds, if fewer), two per pixel as [`sobel_run_words`] gives them, to the
+    /// front of `words` and removes them; returns how many pixels. The fabric device serves
+    /// its Sobel bursts with this; a front end whose FIFO holds the words copies them.
+    fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        let mut filled = 0;
+        self.drain_sobel(max.min(words.len() / 2), &mut |run| {
+            if let Some(free) = words.get_mut(filled * 2..) {
+                filled += sobel_run_words(&run, free);
+            }
+        });
+        filled
+    }
 }
 
 /// Runs a whole `config.width x config.height` frame through `fe`, draining the FIFOs after

@@ -318,4 +318,8 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
     fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.fifos.drain_sobel(max, sink);
     }
+
+    fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        self.fifos.drain_sobel_words(max, words)
+    }
 }

@@ -194,25 +194,34 @@ impl<const W: usize, const W0: usize> Waiting<W0> for Pending<W> {
         Some((run, row_left.min(computed - n)))
     }
 
-    /// Hands the oldest `len` waiting Sobel pixels (of one row) to `out`.
-    #[inline]
-    fn release_sobel(&mut self, len: u32, out: &mut OutputFifos<W0>) {
+    /// The waiting Sobel pixels of the oldest one's row.
+    fn sobel_waiting(&self) -> SobelRun<'_> {
         let (y, x) = self.sobel_at;
         let slot = usize::from(y) % SOBEL_ROWS;
-        let span = usize::from(x)..usize::from(x) + len as usize;
-        let (Some(magnitude), Some(orientation)) = (
-            self.magnitude.get(slot).and_then(|r| r.get(span.clone())),
-            self.orientation.get(slot).and_then(|r| r.get(span)),
-        ) else {
-            return;
-        };
-        out.push_sobel_run(SobelRun {
+        let computed = u32::from(self.sobel_rows) * u32::from(self.width);
+        let left =
+            u32::from(self.width.saturating_sub(x)).min(computed.saturating_sub(self.sobel_next));
+        let span = usize::from(x)..usize::from(x) + left as usize;
+        SobelRun {
             octave: self.octave,
             y,
             x,
-            magnitude,
-            orientation,
-        });
+            magnitude: self
+                .magnitude
+                .get(slot)
+                .and_then(|r| r.get(span.clone()))
+                .unwrap_or_default(),
+            orientation: self
+                .orientation
+                .get(slot)
+                .and_then(|r| r.get(span))
+                .unwrap_or_default(),
+        }
+    }
+
+    /// Lets go of the oldest `len` waiting Sobel pixels (of one row).
+    fn sobel_released(&mut self, len: u32) {
+        let (y, x) = self.sobel_at;
         self.sobel_next += len;
         // `len` is at most what is left of the row.
         let x = x + len as u16;
