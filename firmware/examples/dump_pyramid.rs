@@ -17,7 +17,7 @@ use image::{GrayImage, Luma, Rgb, RgbImage};
 use std::error::Error;
 use std::path::{Path, PathBuf};
 use stereocal_firmware::fabric::fast::Probe;
-use stereocal_firmware::fabric::{Config, Extremum, FastFrontEnd, FrontEnd, SobelPixel};
+use stereocal_firmware::fabric::{Config, Extremum, FastFrontEnd, FrontEnd, SobelEntry};
 
 /// Scale and DoG rows of every octave, as images.
 struct Collect {
@@ -96,10 +96,10 @@ fn main() -> Result<(), Box<dyn Error>> {
             .collect(),
     };
     let mut points: Vec<Extremum> = Vec::new();
-    let mut sobel: Vec<SobelPixel> = Vec::new();
+    let mut sobel: Vec<SobelEntry> = Vec::new();
     let drain = |fe: &mut FastFrontEnd<1280, 640, 320, 160>,
                  p: &mut Vec<Extremum>,
-                 s: &mut Vec<SobelPixel>| {
+                 s: &mut Vec<SobelEntry>| {
         while let Some(x) = fe.pop_point() {
             p.push(x);
         }

@@ -264,7 +264,7 @@
 #define STEREOCAL_POINT_FIFO_DSDOG_DOG_MASK 0xFFFF0000u
 #define STEREOCAL_POINT_FIFO_DSDOG_DOG_RESET 0x0u
 
-/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. */
+/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. */
 #define STEREOCAL_SOBEL_FIFO_DATA_OFFSET 0x48u
 #define STEREOCAL_SOBEL_FIFO_DATA_RESET 0x00000000u
 /* [7:0] ro: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs). */

@@ -282,7 +282,7 @@ localparam integer SC_POINT_FIFO_DSDOG_DOG_WIDTH = 16;
 localparam [31:0] SC_POINT_FIFO_DSDOG_DOG_MASK = 32'hFFFF0000;
 localparam [15:0] SC_POINT_FIFO_DSDOG_DOG_RESET = 16'h0;
 
-// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
+// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
 localparam [7:0] SC_SOBEL_FIFO_DATA_OFFSET = 8'h48;
 localparam [31:0] SC_SOBEL_FIFO_DATA_RESET = 32'h00000000;
 // [7:0] ro: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs).

@@ -787,7 +787,7 @@ pub mod point_fifo_dsdog {
     };
 }
 
-/// Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. Offset 0x48, ro.
+/// Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. Offset 0x48, ro.
 pub mod sobel_fifo_data {
     use crate::{Access, BitRange, Field, Register};
 

@@ -260,7 +260,7 @@ pub trait Registers: RegisterBus {
         self.read_field(&regs::point_fifo_dsdog::DOG) as u16
     }
 
-    // SOBEL_FIFO_DATA (offset 0x48): Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
+    // SOBEL_FIFO_DATA (offset 0x48): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
 
     /// Reads SOBEL_FIFO_DATA once (the read pops the FIFO's head) and returns the whole word.
     fn pop_sobel_fifo_data(&mut self) -> SobelFifoData {
@@ -325,7 +325,7 @@ impl PointFifoData {
     }
 }
 
-/// A value of SOBEL_FIFO_DATA, as [`Registers::pop_sobel_fifo_data`] read it: Head of the Sobel FIFO, word 0 of 2 (SobelPixel of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
+/// A value of SOBEL_FIFO_DATA, as [`Registers::pop_sobel_fifo_data`] read it: Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SobelFifoData(pub u32);
 

@@ -7,7 +7,7 @@ use std::time::Duration;
 use stereocal::driver::{Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame};
 use stereocal::features::Gradients;
 use stereocal::link::{InProcessLink, Link};
-use stereocal_firmware::fabric::{run_frame, Config, Extremum, FastFrontEnd, SobelPixel, SobelRun};
+use stereocal_firmware::fabric::{run_frame, Config, Extremum, FastFrontEnd, SobelEntry, SobelRun};
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hdl::FabricConfig;
 use stereocal_wire::{Camera, ErrorCode};
@@ -62,7 +62,7 @@ fn config(mode: SobelOutput) -> FabricConfig {
 }
 
 /// What the fabric model itself produces for `image`.
-fn reference(config: &FabricConfig, image: &[u8]) -> (Vec<Extremum>, Vec<SobelPixel>) {
+fn reference(config: &FabricConfig, image: &[u8]) -> (Vec<Extremum>, Vec<SobelEntry>) {
     let mut fe: Box<FastFrontEnd<128, 64, 32, 16>> = Box::new(FastFrontEnd::new());
     let (mut points, mut sobel) = (Vec::new(), Vec::new());
     run_frame(

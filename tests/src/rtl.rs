@@ -254,7 +254,7 @@ impl RtlFrontEnd {
 #[cfg(rtl_sim)]
 fn probe_of(o: &ffi::SimObs) -> ClockProbe {
     use stereocal_firmware::fabric::refine::Offset;
-    use stereocal_firmware::fabric::{Extremum, SobelPixel};
+    use stereocal_firmware::fabric::{Extremum, SobelEntry};
     let mut p = ClockProbe::IDLE;
     for (k, q) in p.octaves.iter_mut().enumerate() {
         if o.en[k] == 0 {
@@ -278,7 +278,7 @@ fn probe_of(o: &ffi::SimObs) -> ClockProbe {
             ds: Offset::from_bits(pt[4] as i16),
             dog: pt[5] as i16,
         });
-        q.sobel = on(o.sb_valid[k]).then_some(SobelPixel {
+        q.sobel = on(o.sb_valid[k]).then_some(SobelEntry {
             octave: k as u8,
             orientation: o.sb_ori[k],
             magnitude: o.sb_mag[k],

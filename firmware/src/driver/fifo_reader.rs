@@ -8,11 +8,16 @@
 //! it, by a soft reset).
 //!
 //! Sobel pixels leave in runs of consecutive pixels of one row of one octave, the form the
-//! driver's ring stores in blocks.
+//! driver's ring stores in blocks. The FIFO interleaves the octaves clock by clock (octave 0
+//! pushes a pixel every clock, octave 1 every other clock of every other line, ...), so a
+//! burst is sorted by octave first: each octave's pixels keep their order, and each octave's
+//! runs leave together, octave 0 first. How the runs of different octaves interleave is no
+//! concern of the ring, which keeps a row per octave.
 
 use stereocal_hdl::regs::{sobel_fifo_data as sdata, sobel_fifo_position as spos};
 use stereocal_hdl::{RegisterBus, Registers};
 
+use crate::fabric::config::MAX_OCTAVES;
 use crate::fabric::fifo_words::{point_from_words, POINT_OFFSETS, SOBEL_OFFSETS};
 use crate::fabric::{Extremum, SobelRun};
 
@@ -34,20 +39,24 @@ const fn max(a: usize, b: usize) -> usize {
     }
 }
 
-/// The buffers of a drain: the words of one burst and one run of Sobel pixels.
+/// The buffers of a drain: the words of one burst, and per octave the burst's Sobel pixels
+/// and the runs they make.
 #[derive(Clone, Debug)]
 pub(crate) struct FifoReader {
     words: [u32; BURST_WORDS],
-    magnitude: [u8; SOBEL_BURST],
-    orientation: [u8; SOBEL_BURST],
+    magnitude: [[u8; SOBEL_BURST]; MAX_OCTAVES],
+    orientation: [[u8; SOBEL_BURST]; MAX_OCTAVES],
+    /// Per octave, each run's first position word and first slot.
+    runs: [[(u32, u16); SOBEL_BURST]; MAX_OCTAVES],
 }
 
 impl FifoReader {
     pub(crate) const fn new() -> Self {
         Self {
             words: [0; BURST_WORDS],
-            magnitude: [0; SOBEL_BURST],
-            orientation: [0; SOBEL_BURST],
+            magnitude: [[0; SOBEL_BURST]; MAX_OCTAVES],
+            orientation: [[0; SOBEL_BURST]; MAX_OCTAVES],
+            runs: [[(0, 0); SOBEL_BURST]; MAX_OCTAVES],
         }
     }
 
@@ -89,78 +98,77 @@ impl FifoReader {
                 return Ok(());
             };
             bus.read_burst(&SOBEL_OFFSETS, words);
-            // Pixel i goes to slot i (up to the first entry read as not VALID); a run is a
-            // stretch of slots whose positions follow one another along a row of one octave.
-            let end = words
-                .chunks_exact(2)
-                .position(|entry| entry.first().is_none_or(|&d| sdata::VALID.extract(d) == 0))
-                .unwrap_or(n);
-            let slots = self.magnitude.iter_mut().zip(self.orientation.iter_mut());
-            for (entry, (magnitude, orientation)) in words.chunks_exact(2).take(end).zip(slots) {
-                let data = entry.first().copied().unwrap_or(0);
-                *magnitude = sdata::MAGNITUDE.extract(data) as u8;
-                *orientation = sdata::ORIENTATION.extract(data) as u8;
-            }
-            let entries = words.get(..end * 2).unwrap_or_default();
-            let mut start = 0;
-            while let Some(first) = entries.get(start * 2..start * 2 + 2) {
-                let &[data, position] = first else {
+            // Pixel by pixel up to the first entry read as not VALID: each goes to the next
+            // slot of its octave, and starts a run unless it is the next column of the row
+            // its octave's previous pixel is on (a column wrapping past 0xFFFF would carry into
+            // the row, so runs stop short of it).
+            let mut filled = [0u16; MAX_OCTAVES];
+            let mut count = [0usize; MAX_OCTAVES];
+            let mut next = [u64::MAX; MAX_OCTAVES];
+            let mut valid = 0;
+            for entry in words.chunks_exact(2) {
+                let &[data, position] = entry else { break };
+                if sdata::VALID.extract(data) == 0 {
+                    break;
+                }
+                valid += 1;
+                let o = sdata::OCTAVE.extract(data) as usize % MAX_OCTAVES;
+                let (Some(slot), Some(runs), Some(count), Some(next)) = (
+                    filled.get_mut(o),
+                    self.runs.get_mut(o),
+                    count.get_mut(o),
+                    next.get_mut(o),
+                ) else {
                     break;
                 };
-                // The run goes on while each entry is the next column of the row, in the same
-                // octave: its position minus its distance from the start stays the start's (a
-                // column wrapping past 0xFFFF would carry into the row, so runs stop short of
-                // it).
-                let octave_bits = data & sdata::OCTAVE.mask();
-                let room = 0x1_0000 - spos::X.extract(position) as usize;
-                let len = entries
-                    .get(start * 2..)
-                    .unwrap_or_default()
-                    .chunks_exact(2)
-                    .take(room)
-                    .enumerate()
-                    .position(|(k, e)| {
-                        let &[d, p] = e else { return true };
-                        d & sdata::OCTAVE.mask() != octave_bits
-                            || p.wrapping_sub(k as u32) != position
-                    })
-                    .unwrap_or_else(|| (end - start).min(room));
-                let run = RunStart {
-                    octave: sdata::OCTAVE.extract(data) as u8,
-                    position,
-                    start,
+                if u64::from(position) != *next {
+                    if let Some(run) = runs.get_mut(*count) {
+                        *run = (position, *slot);
+                        *count += 1;
+                    }
+                }
+                *next = if spos::X.extract(position) == spos::X.bits.max_value() {
+                    u64::MAX
+                } else {
+                    u64::from(position) + 1
                 };
-                // `len >= 1`: the first entry is its own run's start.
-                on_run(run.of(&self.magnitude, &self.orientation, start + len.max(1)))?;
-                start += len.max(1);
+                let i = usize::from(*slot);
+                if let (Some(m), Some(r)) = (
+                    self.magnitude.get_mut(o).and_then(|m| m.get_mut(i)),
+                    self.orientation.get_mut(o).and_then(|r| r.get_mut(i)),
+                ) {
+                    *m = sdata::MAGNITUDE.extract(data) as u8;
+                    *r = sdata::ORIENTATION.extract(data) as u8;
+                }
+                *slot += 1;
             }
-            if end < n {
+            for (o, ((runs, &count), &filled)) in
+                self.runs.iter().zip(&count).zip(&filled).enumerate()
+            {
+                let (Some(magnitude), Some(orientation)) =
+                    (self.magnitude.get(o), self.orientation.get(o))
+                else {
+                    break;
+                };
+                let runs = runs.get(..count).unwrap_or_default();
+                let ends = runs.iter().skip(1).map(|&(_, start)| start).chain([filled]);
+                for (&(position, start), end) in runs.iter().zip(ends) {
+                    let span = usize::from(start)..usize::from(end);
+                    on_run(SobelRun {
+                        octave: o as u8,
+                        y: spos::Y.extract(position) as u16,
+                        x: spos::X.extract(position) as u16,
+                        magnitude: magnitude.get(span.clone()).unwrap_or_default(),
+                        orientation: orientation.get(span).unwrap_or_default(),
+                    })?;
+                }
+            }
+            if valid < n {
                 // An entry read as not VALID: the FIFO was emptied under the drain.
                 return Ok(());
             }
             left -= n;
         }
         Ok(())
-    }
-}
-
-/// A run being gathered: its first pixel's octave, position word and slot.
-#[derive(Clone, Copy)]
-struct RunStart {
-    octave: u8,
-    position: u32,
-    start: usize,
-}
-
-impl RunStart {
-    /// The run of slots `start..end` of `magnitude` and `orientation`.
-    fn of<'a>(&self, magnitude: &'a [u8], orientation: &'a [u8], end: usize) -> SobelRun<'a> {
-        SobelRun {
-            octave: self.octave,
-            y: spos::Y.extract(self.position) as u16,
-            x: spos::X.extract(self.position) as u16,
-            magnitude: magnitude.get(self.start..end).unwrap_or_default(),
-            orientation: orientation.get(self.start..end).unwrap_or_default(),
-        }
     }
 }

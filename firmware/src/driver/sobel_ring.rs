@@ -1,6 +1,7 @@
 //! The last rows of every octave's Sobel image, assembled from the fabric's Sobel stream.
 //!
-//! The fabric streams Sobel pixels in raster order within each octave (octaves interleaved).
+//! The fabric streams Sobel pixels in raster order within each octave (octaves interleaved
+//! clock by clock).
 //! The ring keeps the last [`RING_ROWS`] complete rows of each octave: enough for a full row
 //! to be sent as `SobelRows`, or for a 16x16 patch to be cut around a point that arrives up to
 //! `RING_ROWS - 17` rows after the Sobel row it sits on (the fabric's points lag its Sobel rows
@@ -16,7 +17,7 @@ use stereocal_wire::{SobelPixel, PATCH_PIXELS, PATCH_SIZE};
 
 use crate::fabric::config::MAX_OCTAVES;
 use crate::fabric::geometry::octave_dims;
-use crate::fabric::{SobelPixel as FabricSobel, SobelRun};
+use crate::fabric::{SobelEntry, SobelRun};
 
 /// Complete rows kept per octave.
 pub const RING_ROWS: usize = 32;
@@ -155,7 +156,7 @@ impl<const W0: usize> SobelRing<W0> {
     }
 
     /// Stores one pixel of the fabric's Sobel stream and reports the rows it completed.
-    pub fn push(&mut self, pixel: &FabricSobel) -> Result<Option<Completed>, OutOfOrder> {
+    pub fn push(&mut self, pixel: &SobelEntry) -> Result<Option<Completed>, OutOfOrder> {
         let out_of_order = OutOfOrder {
             octave: pixel.octave,
             x: pixel.x,

@@ -44,9 +44,16 @@
 //! ([`latency::first_pixel_of_last_octave`], checked against the model's clocks by
 //! `tests/latency.rs`), stored once that many clocks have passed.
 //!
+//! # FIFO order
+//! Both FIFOs hold their entries in the RTL's order, whichever datapath is behind the device:
+//! by clock, and within a clock octave 0 first (`sc_out_fifo` takes the four octaves' items
+//! of a clock in octave order). Between line times the FIFO contents, levels and overflow
+//! counters are the register-level model's entry for entry, so a program that reads the
+//! same registers between the same line times pops the same words and sees the same drops
+//! from either datapath (`tests/fifo_order.rs`).
+//!
 //! What a program can observe therefore matches the RTL register for register, but not clock
-//! for clock: when the FIFOs fill within a line, and (with the fast path) the order in which
-//! octaves interleave their entries, follow the datapath's granularity.
+//! for clock: the entries a line time brings arrive together at its end.
 
 use stereocal_hdl::regs::{
     control, frame_count, latency_clocks, point_fifo_data, point_fifo_dsdog, point_fifo_dxdy,
@@ -56,7 +63,7 @@ use stereocal_hdl::regs::{
 use stereocal_hdl::{PixelIn, RegisterBank, RegisterBus, Registers};
 
 use crate::fabric::config::Config;
-use crate::fabric::fifo_words::{point_words, sobel_run_words, sobel_words, SOBEL_OFFSETS};
+use crate::fabric::fifo_words::{point_words, sobel_words, SOBEL_OFFSETS};
 use crate::fabric::latency;
 use crate::fabric::output::{FrontEnd, Overflow};
 
@@ -312,8 +319,8 @@ impl<F: FrontEnd, const W0: usize> RegisterBus for FabricDevice<F, W0> {
         }
     }
 
-    /// Bursts over SOBEL_FIFO_DATA and SOBEL_FIFO_POSITION take the datapath's Sobel FIFO by
-    /// runs; any other burst is read word by word. Either way the words are those of
+    /// Bursts over SOBEL_FIFO_DATA and SOBEL_FIFO_POSITION take the datapath's Sobel FIFO's
+    /// words at once ([`FrontEnd::drain_sobel_words`]); any other burst is read word by word. Either way the words are those of
     /// [`RegisterBus::read`] one at a time.
     fn read_burst(&mut self, offsets: &[u16], words: &mut [u32]) {
         if offsets != SOBEL_OFFSETS {
@@ -326,12 +333,7 @@ impl<F: FrontEnd, const W0: usize> RegisterBus for FabricDevice<F, W0> {
         let Some((whole, rest)) = words.split_at_mut_checked(pairs * 2) else {
             return;
         };
-        let mut filled = 0;
-        self.datapath.drain_sobel(pairs, &mut |run| {
-            if let Some(free) = whole.get_mut(filled * 2..) {
-                filled += sobel_run_words(&run, free);
-            }
-        });
+        let filled = self.datapath.drain_sobel_words(pairs, whole);
         // Pops of an empty FIFO read 0 and zero the holding register.
         let Some((popped, empty)) = whole.split_at_mut_checked(filled * 2) else {
             return;

@@ -1,6 +1,6 @@
 //! Bounded FIFO over `LINES` line memories of `W` entries (capacity `LINES·W`): the alignment
 //! delays between scale images and the point FIFO the soft-core drains (the Sobel FIFO holds
-//! row runs: `sobel_fifo.rs`). Pushing into a full FIFO hands the value back; the caller
+//! register words: `sobel_fifo.rs`). Pushing into a full FIFO hands the value back; the caller
 //! counts it (nothing is dropped silently).
 //!
 //! Every access goes through `get`/`split_at_mut_checked`: the ring indices are below the
@@ -74,6 +74,15 @@ impl<T: Copy, const W: usize, const LINES: usize> LineFifo<T, W, LINES> {
             sink(run);
         }
         self.clear();
+    }
+
+    /// The oldest entry, left in place.
+    #[inline]
+    pub fn peek(&self) -> Option<&T> {
+        if self.len == 0 {
+            return None;
+        }
+        self.mem.as_flattened().get(self.head)
     }
 
     /// Removes the oldest entry.

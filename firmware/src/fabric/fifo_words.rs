@@ -1,9 +1,10 @@
 //! The register words of a FIFO entry: how a point fills POINT_FIFO_DATA, POINT_FIFO_DXDY and
 //! POINT_FIFO_DSDOG, and a Sobel pixel SOBEL_FIFO_DATA and SOBEL_FIFO_POSITION.
 //!
-//! The fabric device ([`crate::fabric::device`]) encodes with these functions and the driver
-//! decodes points with them (Sobel words it decodes a burst at a time, with the same generated
-//! field constants of the register map). A word read from an empty FIFO has VALID clear.
+//! The fabric device ([`crate::fabric::device`]) and the Sobel FIFO that stores these words
+//! ([`crate::fabric::sobel_fifo`]) encode with these functions and the driver decodes points
+//! with them (Sobel words it decodes a burst at a time, with the same generated field
+//! constants of the register map). A word read from an empty FIFO has VALID clear.
 
 use stereocal_hdl::regs::{
     point_fifo_data as pdata, point_fifo_dsdog as pdsdog, point_fifo_dxdy as pdxdy,
@@ -11,7 +12,7 @@ use stereocal_hdl::regs::{
 };
 use stereocal_hdl::Field;
 
-use crate::fabric::output::{Extremum, SobelPixel};
+use crate::fabric::output::{Extremum, SobelEntry};
 use crate::fabric::refine::Offset;
 use crate::fabric::sobel_fifo::SobelRun;
 
@@ -70,34 +71,67 @@ pub fn point_from_words(words: [u32; 3]) -> Option<Extremum> {
     })
 }
 
+/// What the words of every pixel of one row of one octave share, so that a pixel's words
+/// cost its own three fields.
+#[derive(Clone, Copy, Debug)]
+pub struct SobelRowWords {
+    data: u32,
+    position: u32,
+}
+
+impl SobelRowWords {
+    /// For row `y` of `octave`.
+    #[inline]
+    pub const fn new(octave: u8, y: u16) -> Self {
+        Self {
+            data: put(&sdata::OCTAVE, octave as u32) | put(&sdata::VALID, 1),
+            position: put(&spos::Y, y as u32),
+        }
+    }
+
+    /// The two words of the row's pixel at column `x`.
+    #[inline(always)]
+    pub const fn pixel(&self, x: u16, magnitude: u8, orientation: u8) -> [u32; 2] {
+        [
+            self.data
+                | put(&sdata::MAGNITUDE, magnitude as u32)
+                | put(&sdata::ORIENTATION, orientation as u32),
+            self.position | put(&spos::X, x as u32),
+        ]
+    }
+}
+
 /// `pixel` as the two words the fabric shows after popping it.
 #[inline]
-pub fn sobel_words(pixel: &SobelPixel) -> [u32; 2] {
-    [
-        put(&sdata::MAGNITUDE, pixel.magnitude.into())
-            | put(&sdata::ORIENTATION, pixel.orientation.into())
-            | put(&sdata::OCTAVE, pixel.octave.into())
-            | put(&sdata::VALID, 1),
-        put(&spos::X, pixel.x.into()) | put(&spos::Y, pixel.y.into()),
-    ]
+pub fn sobel_words(pixel: &SobelEntry) -> [u32; 2] {
+    SobelRowWords::new(pixel.octave, pixel.y).pixel(pixel.x, pixel.magnitude, pixel.orientation)
+}
+
+/// The Sobel pixel two words read after one pop hold, or `None` when the FIFO was empty.
+#[inline]
+pub fn sobel_from_words(words: [u32; 2]) -> Option<SobelEntry> {
+    let [data, position] = words;
+    if sdata::VALID.extract(data) == 0 {
+        return None;
+    }
+    Some(SobelEntry {
+        octave: sdata::OCTAVE.extract(data) as u8,
+        orientation: sdata::ORIENTATION.extract(data) as u8,
+        magnitude: sdata::MAGNITUDE.extract(data) as u8,
+        x: spos::X.extract(position) as u16,
+        y: spos::Y.extract(position) as u16,
+    })
 }
 
 /// The words of `run`'s pixels, two per pixel as [`sobel_words`] gives them, into the front
 /// of `words`; returns how many pixels fit.
 #[inline]
 pub fn sobel_run_words(run: &SobelRun<'_>, words: &mut [u32]) -> usize {
-    let data = put(&sdata::OCTAVE, run.octave.into()) | put(&sdata::VALID, 1);
-    let y = put(&spos::Y, run.y.into());
+    let row = SobelRowWords::new(run.octave, run.y);
     let mut n = 0;
     let pixels = run.magnitude.iter().zip(run.orientation);
     for (entry, (&magnitude, &orientation)) in words.chunks_exact_mut(2).zip(pixels) {
-        if let [pixel, position] = entry {
-            let x = run.x.wrapping_add(n as u16);
-            *pixel = data
-                | put(&sdata::MAGNITUDE, magnitude.into())
-                | put(&sdata::ORIENTATION, orientation.into());
-            *position = y | put(&spos::X, x.into());
-        }
+        entry.copy_from_slice(&row.pixel(run.x.wrapping_add(n as u16), magnitude, orientation));
         n += 1;
     }
     n
@@ -122,7 +156,7 @@ mod tests {
             dog: -32768,
         };
         assert_eq!(point_from_words(point_words(&point)), Some(point));
-        let pixel = SobelPixel {
+        let pixel = SobelEntry {
             octave: 2,
             orientation: 63,
             magnitude: 255,
@@ -130,6 +164,7 @@ mod tests {
             y: 255,
         };
         let [data, position] = sobel_words(&pixel);
+        assert_eq!(sobel_from_words([data, position]), Some(pixel));
         assert_eq!(sdata::MAGNITUDE.extract(data), 255);
         assert_eq!(sdata::ORIENTATION.extract(data), 63);
         assert_eq!(sdata::OCTAVE.extract(data), 2);
@@ -161,5 +196,6 @@ mod tests {
     #[test]
     fn words_of_an_empty_fifo_decode_to_nothing() {
         assert_eq!(point_from_words([0; 3]), None);
+        assert_eq!(sobel_from_words([0; 2]), None);
     }
 }

@@ -54,22 +54,78 @@ pub const fn octave_to_sobel(width: u16, k: u8, sobel_scale: u8) -> u32 {
 /// Clock at which octave `k` receives its input sample number `n` (raster index) for a
 /// `width x height` frame whose first pixel enters at clock 0.
 pub const fn sample_clock(width: u16, height: u16, k: u8, n: u32) -> u64 {
+    enabled_clock(width, height, k, n as u64)
+}
+
+/// Clock (from the frame's first pixel at clock 0) of octave `k`'s enabled clock number `m`:
+/// an octave takes its input sample `n` on its enabled clock `n` and hands out the item of
+/// sample `n` on its enabled clock `n + latency`, so this is when that item leaves.
+///
+/// Octave 0 is enabled on every clock (a pixel a clock, then flushing), so its enabled clock
+/// `m` is clock `m`. Octave `k >= 1` is enabled when the subsampler of octave `k - 1` hands it
+/// sample `n = y·w + x`, which is that octave's sample `2y·w' + 2x` [`octave_to_next`] enabled
+/// clocks on, and, once its `w x h` samples are in, on every clock until it has drained.
+pub const fn enabled_clock(width: u16, height: u16, k: u8, m: u64) -> u64 {
+    enabled_run(width, height, k, m).clock
+}
+
+/// Enabled clocks of one octave that follow one another at a fixed distance: from enabled
+/// clock `m` on, `len` of them, the `j`-th at `clock + j·stride`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ClockRun {
+    /// Clock of the first.
+    pub clock: u64,
+    /// Clocks between two of them: a power of two.
+    pub stride: u64,
+    /// How many (at least 1; `u64::MAX` when they go on for ever, as a flushing octave's).
+    pub len: u64,
+}
+
+/// The longest [`ClockRun`] of octave `k` from its enabled clock `m` ([`enabled_clock`]
+/// explains the schedule). Within one row of its input an octave `k >= 1` is enabled every
+/// other enabled clock of octave `k - 1`; a run ends at the end of that row, where octave
+/// `k - 1`'s run under it ends, or where the octave's input ends and it flushes every clock.
+pub const fn enabled_run(width: u16, height: u16, k: u8, m: u64) -> ClockRun {
     if k == 0 {
-        return n as u64;
+        return ClockRun {
+            clock: m,
+            stride: 1,
+            len: u64::MAX,
+        };
     }
-    let (w, _) = octave_dims(width, height, k);
-    let (pw, ph) = octave_dims(width, height, k - 1);
+    let (w, h) = octave_dims(width, height, k);
+    let total = w as u64 * h as u64;
     // An empty octave (a zero-width frame, which no configuration allows) has no samples.
-    let (Some(x), Some(y)) = (n.checked_rem(w as u32), n.checked_div(w as u32)) else {
-        return 0;
-    };
-    let parent = 2 * y * pw as u32 + 2 * x;
-    let e = parent + octave_to_next(pw, k - 1);
-    let parent_total = pw as u32 * ph as u32;
-    if e < parent_total {
-        sample_clock(width, height, k - 1, e)
-    } else {
-        sample_clock(width, height, k - 1, parent_total - 1) + (e - parent_total + 1) as u64
+    if total == 0 {
+        return ClockRun {
+            clock: 0,
+            stride: 1,
+            len: u64::MAX,
+        };
+    }
+    if m >= total {
+        let last = enabled_clock(width, height, k, total - 1);
+        return ClockRun {
+            clock: last + (m - total + 1),
+            stride: 1,
+            len: u64::MAX,
+        };
+    }
+    let (pw, _) = octave_dims(width, height, k - 1);
+    let (y, x) = (m / w as u64, m % w as u64);
+    let parent = enabled_run(
+        width,
+        height,
+        k - 1,
+        2 * y * pw as u64 + 2 * x + octave_to_next(pw, k - 1) as u64,
+    );
+    // Sample `m + j` is the parent's enabled clock `2j` further on, within this row.
+    let under = parent.len / 2 + parent.len % 2;
+    let row = w as u64 - x;
+    ClockRun {
+        clock: parent.clock,
+        stride: 2 * parent.stride,
+        len: if under < row { under } else { row },
     }
 }
 

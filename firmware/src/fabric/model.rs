@@ -1,13 +1,14 @@
 //! A datapath chosen at run time: the fast path (the default) or the register-level model.
 //!
-//! Both produce the same points and Sobel pixels; the register-level model is the clock-level
-//! specification of the RTL and is much slower, so the soft-core and the host run the fast
-//! path unless asked otherwise. The two interleave their octaves differently, so the FIFOs
-//! (and the packets of a frame) hold the same entries per octave in a different order.
+//! Both push the same points and Sobel pixels into the FIFOs in the same order, line time by
+//! line time (the RTL's: by clock, octave 0 first within a clock), so the packets of a frame
+//! are the same bytes; the register-level model is the clock-level specification of the RTL
+//! and is much slower, so the soft-core and the host run the fast path unless asked
+//! otherwise.
 
 use crate::fabric::{
     Config, ConfigError, Extremum, FastFrontEnd, FrameError, FrontEnd, Overflow, RegisterFrontEnd,
-    SobelPixel, SobelRun,
+    SobelEntry, SobelRun,
 };
 
 /// Which implementation of the fabric runs the frames.
@@ -93,7 +94,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         }
     }
 
-    fn pop_sobel(&mut self) -> Option<SobelPixel> {
+    fn pop_sobel(&mut self) -> Option<SobelEntry> {
         match self {
             Self::Fast(fe) => fe.pop_sobel(),
             Self::RegisterLevel(fe) => fe.pop_sobel(),
@@ -127,5 +128,9 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
 
     fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.front_end().drain_sobel(max, sink)
+    }
+
+    fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        self.front_end().drain_sobel_words(max, words)
     }
 }

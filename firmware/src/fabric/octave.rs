@@ -26,7 +26,7 @@ use crate::fabric::edge::passes_edge_test;
 use crate::fabric::extrema::{is_extremum, Cube};
 use crate::fabric::fifo::LineFifo;
 use crate::fabric::geometry::octave_dims;
-use crate::fabric::output::{Extremum, OutputFifos, SobelPixel};
+use crate::fabric::output::{Extremum, OutputFifos, SobelEntry};
 use crate::fabric::probe::OctaveProbe;
 use crate::fabric::refine::{refine, REFINE_LATENCY};
 use crate::fabric::sobel::sobel;
@@ -217,7 +217,7 @@ impl<const W: usize> Octave<W> {
 
         // Sobel branch.
         if let Some((x, y, magnitude, orientation)) = self.cordic.clock(self.gradient_reg.take()) {
-            let px = SobelPixel {
+            let px = SobelEntry {
                 octave: self.index,
                 orientation,
                 magnitude,

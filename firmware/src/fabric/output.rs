@@ -13,14 +13,16 @@
 //! 4. `overflow()` tells how many items were dropped because the driver fell behind; the
 //!    counters are never reset silently (only `reset` clears them).
 //!
-//! Within one octave both streams come in raster order; the octaves are interleaved in an
-//! implementation-defined way (the register-level model interleaves them by clock, the fast
-//! path by row), so consumers key on the `octave` field.
+//! Within one octave both streams come in raster order; the octaves interleave as the RTL
+//! pushes them, by clock and octave 0 first within a clock, in both implementations: after
+//! every `push_row` and `blank_row` the FIFOs hold the same entries in the same order and the
+//! counters agree (`tests/fifo_order.rs`).
 
 use crate::fabric::config::{Config, ConfigError};
 use crate::fabric::fifo::LineFifo;
+use crate::fabric::fifo_words::sobel_run_words;
 use crate::fabric::refine::Offset;
-use crate::fabric::sobel_fifo::{SobelFifo, SobelRun};
+use crate::fabric::sobel_fifo::{SobelAppend, SobelFifo, SobelRun};
 
 /// A refined DoG extremum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,7 +61,7 @@ impl Extremum {
 
 /// One Sobel output pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SobelPixel {
+pub struct SobelEntry {
     /// Octave 0..4.
     pub octave: u8,
     /// Orientation bin 0..64 (5.625° each, from +x toward +y).
@@ -142,25 +144,16 @@ impl<const W0: usize> OutputFifos<W0> {
 
     /// Enqueues a Sobel pixel, counting it when full.
     #[inline]
-    pub fn push_sobel(&mut self, s: SobelPixel) {
+    pub fn push_sobel(&mut self, s: SobelEntry) {
         if self.sobel.push(s).is_err() {
             self.overflow.sobel = self.overflow.sobel.saturating_add(1);
         }
     }
 
-    /// Enqueues a row of Sobel pixels `(i, y)` of `octave`; what does not fit is counted.
+    /// Something that enqueues Sobel pixels until it is dropped, counting what does not fit.
     #[inline]
-    pub fn push_sobel_row(&mut self, octave: u8, y: u16, magnitude: &[u8], orientation: &[u8]) {
-        let n = magnitude.len().min(orientation.len());
-        let row = SobelRun {
-            octave,
-            y,
-            x: 0,
-            magnitude,
-            orientation,
-        };
-        let fit = self.sobel.push_run(row);
-        self.overflow.sobel = self.overflow.sobel.saturating_add((n - fit) as u32);
+    pub fn append_sobel(&mut self) -> SobelAppend<'_> {
+        self.sobel.append(&mut self.overflow.sobel)
     }
 
     /// Hands all queued points to `sink` (at most two slices) and empties the FIFO.
@@ -174,6 +167,13 @@ impl<const W0: usize> OutputFifos<W0> {
         self.sobel.drain(max, sink);
     }
 
+    /// Copies the words of the oldest `max` queued Sobel pixels (all, and no more than
+    /// `words` holds, if fewer) into `words`, two per pixel, and removes them; returns how
+    /// many pixels.
+    pub fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        self.sobel.drain_words(max, words)
+    }
+
     /// Oldest point.
     #[inline]
     pub fn pop_point(&mut self) -> Option<Extremum> {
@@ -182,7 +182,7 @@ impl<const W0: usize> OutputFifos<W0> {
 
     /// Oldest Sobel pixel.
     #[inline]
-    pub fn pop_sobel(&mut self) -> Option<SobelPixel> {
+    pub fn pop_sobel(&mut self) -> Option<SobelEntry> {
         self.sobel.pop()
     }
 
@@ -254,7 +254,7 @@ pub trait FrontEnd {
     /// Oldest point of the point FIFO.
     fn pop_point(&mut self) -> Option<Extremum>;
     /// Oldest pixel of the Sobel FIFO.
-    fn pop_sobel(&mut self) -> Option<SobelPixel>;
+    fn pop_sobel(&mut self) -> Option<SobelEntry>;
     /// Items dropped since the last [`FrontEnd::reset`] (saturating).
     fn overflow(&self) -> Overflow;
     /// Entries waiting in the point FIFO.
@@ -266,6 +266,19 @@ pub trait FrontEnd {
     /// Hands the oldest `max` queued Sobel pixels (all, if fewer) to `sink`, oldest first, in
     /// runs of consecutive pixels of one row, and removes them.
     fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>));
+    /// Writes the register words of the oldest `max` queued Sobel pixels (all, and no more
+    /// than `words` holds, if fewer), two per pixel as [`sobel_run_words`] gives them, to the
+    /// front of `words` and removes them; returns how many pixels. The fabric device serves
+    /// its Sobel bursts with this; a front end whose FIFO holds the words copies them.
+    fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        let mut filled = 0;
+        self.drain_sobel(max.min(words.len() / 2), &mut |run| {
+            if let Some(free) = words.get_mut(filled * 2..) {
+                filled += sobel_run_words(&run, free);
+            }
+        });
+        filled
+    }
 }
 
 /// Runs a whole `config.width x config.height` frame through `fe`, draining the FIFOs after

@@ -7,7 +7,7 @@
 
 use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::octave::Octave;
-use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
+use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelEntry};
 use crate::fabric::probe::ClockProbe;
 use crate::fabric::sobel_fifo::SobelRun;
 
@@ -208,7 +208,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.fifos.pop_point()
     }
 
-    fn pop_sobel(&mut self) -> Option<SobelPixel> {
+    fn pop_sobel(&mut self) -> Option<SobelEntry> {
         self.fifos.pop_sobel()
     }
 
@@ -230,5 +230,9 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
 
     fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.fifos.drain_sobel(max, sink);
+    }
+
+    fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        self.fifos.drain_sobel_words(max, words)
     }
 }

@@ -23,7 +23,7 @@
 //! interface (`push_row`, `blank_row`: the driver's and the benchmark's path) clocks without
 //! it (a const generic). Nothing is allocated.
 
-use crate::fabric::output::{Extremum, SobelPixel};
+use crate::fabric::output::{Extremum, SobelEntry};
 
 /// The observation signals of one octave during one clock.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -39,7 +39,7 @@ pub struct OctaveProbe {
     /// The point pushed into the point FIFO.
     pub point: Option<Extremum>,
     /// The Sobel pixel pushed into the Sobel FIFO.
-    pub sobel: Option<SobelPixel>,
+    pub sobel: Option<SobelEntry>,
 }
 
 impl OctaveProbe {

@@ -1,18 +1,19 @@
-//! The Sobel FIFO, held as row runs: magnitudes and orientations in two byte rings, and for
-//! each run of consecutive pixels of one row its octave, row, first column and length.
+//! The Sobel FIFO, held as the register words its pixels are read as: per pixel the
+//! SOBEL_FIFO_DATA word and the SOBEL_FIFO_POSITION word ([`crate::fabric::fifo_words`]).
 //!
-//! Both front ends emit the Sobel stream along rows (the fast path a whole row per call, the
-//! register-level model one pixel per clock), and the driver stores it by rows. As runs, a
-//! row goes in as two copies and leaves as two slices, where a queue of pixel records cost an
-//! 8-byte record per pixel on the way in and, on the way out, a check per pixel that it
-//! continues the row before it. The pixel stream is unchanged: the same order, the same
-//! capacity in pixels, the same pixels dropped when full, and [`SobelFifo::pop`] still takes
-//! one pixel at a time (the `SOBEL_FIFO_DATA` register).
+//! The device reads the FIFO in bursts over those two registers, so a burst is a copy out of
+//! the ring ([`SobelFifo::drain_words`]), and a pixel costs its words once, on the way in.
+//! Two words are no more than a pixel's bytes with a share of a run record cost, and unlike
+//! runs they cost nothing extra when the octaves interleave clock by clock and every run is
+//! a pixel or two long. [`SobelFifo::pop`] takes one pixel (the `SOBEL_FIFO_DATA` register)
+//! and [`SobelFifo::drain`] gathers pixels back into row runs for programs that take the
+//! stream without the registers.
 //!
 //! Every access is checked (`get`, iterators), so the firmware links no panicking path
 //! through here (tests/tests/firmware_panic_free.rs).
 
-use crate::fabric::output::SobelPixel;
+use crate::fabric::fifo_words::{sobel_from_words, SobelRowWords};
+use crate::fabric::output::SobelEntry;
 
 /// Consecutive pixels `x, x + 1, ..` of row `y` of `octave`, oldest first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,7 +32,8 @@ pub struct SobelRun<'a> {
 
 impl<'a> SobelRun<'a> {
     /// The run of the one pixel `p`.
-    pub fn single(p: &'a SobelPixel) -> Self {
+    #[inline]
+    pub fn single(p: &'a SobelEntry) -> Self {
         Self {
             octave: p.octave,
             y: p.y,
@@ -42,16 +44,19 @@ impl<'a> SobelRun<'a> {
     }
 
     /// Pixels in the run.
+    #[inline]
     pub fn len(&self) -> usize {
         self.magnitude.len().min(self.orientation.len())
     }
 
     /// Whether the run has no pixel.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 
     /// The first `n` pixels (all of them if fewer) and the rest.
+    #[inline]
     pub fn split_at(&self, n: usize) -> (Self, Self) {
         let n = n.min(self.len());
         let (m0, m1) = self.magnitude.split_at_checked(n).unwrap_or_default();
@@ -71,10 +76,11 @@ impl<'a> SobelRun<'a> {
     }
 
     /// The pixels, oldest first.
-    pub fn pixels(&self) -> impl Iterator<Item = SobelPixel> + 'a {
+    #[inline]
+    pub fn pixels(&self) -> impl Iterator<Item = SobelEntry> + 'a {
         let (octave, y, x) = (self.octave, self.y, self.x);
         self.magnitude.iter().zip(self.orientation).enumerate().map(
-            move |(i, (&magnitude, &orientation))| SobelPixel {
+            move |(i, (&magnitude, &orientation))| SobelEntry {
                 octave,
                 orientation,
                 magnitude,
@@ -85,40 +91,19 @@ impl<'a> SobelRun<'a> {
     }
 }
 
-/// A queued run: its pixels follow the previous run's in the rings.
-#[derive(Clone, Copy, Debug)]
-struct Run {
-    octave: u8,
-    y: u16,
-    x: u16,
-    len: u16,
-}
-
-impl Run {
-    const EMPTY: Self = Self {
-        octave: 0,
-        y: 0,
-        x: 0,
-        len: 0,
-    };
-}
-
-/// A FIFO of `W * LINES` Sobel pixels, stored as runs.
+/// A FIFO of `W * LINES` Sobel pixels, each stored as its two register words.
 #[derive(Clone, Debug)]
 pub struct SobelFifo<const W: usize, const LINES: usize> {
-    magnitude: [[u8; W]; LINES],
-    orientation: [[u8; W]; LINES],
-    /// A ring of run headers; no run is empty, so there are never more than pixels.
-    runs: [[Run; W]; LINES],
+    /// A ring of pixels: SOBEL_FIFO_DATA's word, then SOBEL_FIFO_POSITION's.
+    words: [[[u32; 2]; W]; LINES],
     /// Ring index of the oldest pixel.
     head: usize,
     /// Pixels queued.
     len: usize,
-    /// Ring index of the oldest run.
-    run_head: usize,
-    /// Runs queued.
-    run_count: usize,
 }
+
+/// Pixels [`SobelFifo::drain`] decodes into one run at most.
+const DRAIN_RUN: usize = 256;
 
 impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     /// Pixels the FIFO holds.
@@ -127,13 +112,9 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     /// An empty FIFO.
     pub const fn new() -> Self {
         Self {
-            magnitude: [[0; W]; LINES],
-            orientation: [[0; W]; LINES],
-            runs: [[Run::EMPTY; W]; LINES],
+            words: [[[0; 2]; W]; LINES],
             head: 0,
             len: 0,
-            run_head: 0,
-            run_count: 0,
         }
     }
 
@@ -141,8 +122,6 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     pub fn clear(&mut self) {
         self.head = 0;
         self.len = 0;
-        self.run_head = 0;
-        self.run_count = 0;
     }
 
     /// Pixels queued.
@@ -155,7 +134,7 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
         self.len == 0
     }
 
-    /// `i` taken back into the rings (`i < 2 * CAPACITY`).
+    /// `i` taken back into the ring (`i < 2 * CAPACITY`).
     fn wrap(i: usize) -> usize {
         if i >= Self::CAPACITY {
             i - Self::CAPACITY
@@ -164,8 +143,13 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
         }
     }
 
+    /// The ring as words, two per pixel.
+    fn ring(&self) -> &[u32] {
+        self.words.as_flattened().as_flattened()
+    }
+
     /// Enqueues one pixel; when full, hands it back.
-    pub fn push(&mut self, p: SobelPixel) -> Result<(), SobelPixel> {
+    pub fn push(&mut self, p: SobelEntry) -> Result<(), SobelEntry> {
         if self.push_run(SobelRun::single(&p)) == 1 {
             Ok(())
         } else {
@@ -173,118 +157,198 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
         }
     }
 
-    /// Enqueues the leading pixels of `run`, as many as fit; returns how many did.
+    /// Enqueues the leading pixels of `run`, as many as fit, as their words; returns how
+    /// many did.
     pub fn push_run(&mut self, run: SobelRun<'_>) -> usize {
-        let fit = run.len().min(Self::CAPACITY - self.len);
-        let at = Self::wrap(self.head + self.len);
-        // Up to the end of the rings, then from their start.
-        let (first, second) = run.split_at(fit).0.split_at(Self::CAPACITY - at);
-        let mut written = 0;
-        for (at, part) in [(at, first), (0, second)] {
-            if part.is_empty() {
-                continue;
-            }
-            let rings = (
-                self.magnitude
-                    .as_flattened_mut()
-                    .get_mut(at..at + part.magnitude.len()),
-                self.orientation
-                    .as_flattened_mut()
-                    .get_mut(at..at + part.orientation.len()),
-            );
-            let (Some(magnitude), Some(orientation)) = rings else {
-                break;
-            };
-            magnitude.copy_from_slice(part.magnitude);
-            orientation.copy_from_slice(part.orientation);
-            self.len += part.len();
-            self.append(part.octave, part.y, part.x, part.len() as u16, at);
-            written += part.len();
-        }
-        written
+        let mut dropped = 0;
+        let mut append = self.append(&mut dropped);
+        append.push_run(run)
     }
 
-    /// Records `len` pixels just stored at ring index `at` as pixels `x..` of row `y`: they
-    /// extend the newest run when they continue its row and follow it in the rings (not
-    /// across their end), else they start a run.
-    fn append(&mut self, octave: u8, y: u16, x: u16, len: u16, at: usize) {
-        if at != 0 && self.run_count > 0 {
-            let newest = Self::wrap(self.run_head + self.run_count - 1);
-            if let Some(run) = self.runs.as_flattened_mut().get_mut(newest) {
-                if run.octave == octave && run.y == y && run.x.wrapping_add(run.len) == x {
-                    if let Some(longer) = run.len.checked_add(len) {
-                        run.len = longer;
-                        return;
-                    }
-                }
-            }
-        }
-        let slot = Self::wrap(self.run_head + self.run_count);
-        if let Some(run) = self.runs.as_flattened_mut().get_mut(slot) {
-            *run = Run { octave, y, x, len };
-            self.run_count += 1;
+    /// Something that enqueues pixels until it is dropped, counting what does not fit into
+    /// `dropped` (saturating): one pass over the FIFO's state for many short runs.
+    #[inline]
+    pub fn append<'a>(&'a mut self, dropped: &'a mut u32) -> SobelAppend<'a> {
+        let at = Self::wrap(self.head + self.len);
+        SobelAppend {
+            ring: self.words.as_flattened_mut(),
+            at,
+            free: Self::CAPACITY - self.len,
+            pushed: 0,
+            len: &mut self.len,
+            lost: 0,
+            dropped,
         }
     }
 
     /// Takes the oldest pixel.
-    pub fn pop(&mut self) -> Option<SobelPixel> {
+    pub fn pop(&mut self) -> Option<SobelEntry> {
         if self.len == 0 {
             return None;
         }
-        let run = self.runs.as_flattened_mut().get_mut(self.run_head)?;
-        let pixel = SobelPixel {
-            octave: run.octave,
-            orientation: *self.orientation.as_flattened().get(self.head)?,
-            magnitude: *self.magnitude.as_flattened().get(self.head)?,
-            x: run.x,
-            y: run.y,
-        };
-        run.x = run.x.wrapping_add(1);
-        run.len = run.len.saturating_sub(1);
-        if run.len == 0 {
-            self.run_head = Self::wrap(self.run_head + 1);
-            self.run_count -= 1;
-        }
+        let words = *self.words.as_flattened().get(self.head)?;
         self.head = Self::wrap(self.head + 1);
         self.len -= 1;
-        Some(pixel)
+        sobel_from_words(words)
+    }
+
+    /// Copies the words of the oldest `max` queued pixels (all of them, and no more than
+    /// `words` holds, if fewer) to the front of `words` and removes them; returns how many
+    /// pixels it copied.
+    pub fn drain_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        let n = max.min(self.len).min(words.len() / 2);
+        // Up to the end of the ring, then from its start.
+        let first = n.min(Self::CAPACITY - self.head);
+        let ring = self.ring();
+        let parts = (
+            ring.get(2 * self.head..2 * (self.head + first)),
+            ring.get(..2 * (n - first)),
+        );
+        let (Some(tail), Some(start)) = parts else {
+            return 0;
+        };
+        let Some((to_tail, rest)) = words.split_at_mut_checked(tail.len()) else {
+            return 0;
+        };
+        let Some(to_start) = rest.get_mut(..start.len()) else {
+            return 0;
+        };
+        to_tail.copy_from_slice(tail);
+        to_start.copy_from_slice(start);
+        self.head = Self::wrap(self.head + n);
+        self.len -= n;
+        n
     }
 
     /// Hands the oldest `max` queued pixels (all of them, if fewer) to `sink` in runs, oldest
     /// first, and removes them.
     pub fn drain(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        let mut left = max.min(self.len);
-        while left > 0 && self.run_count > 0 {
-            // Runs never straddle the end of the ring (`push_run` splits them there).
-            let Some(run) = self.runs.as_flattened_mut().get_mut(self.run_head) else {
-                break;
-            };
-            let n = usize::from(run.len).min(left);
-            let at = self.head;
-            let (Some(magnitude), Some(orientation)) = (
-                self.magnitude.as_flattened().get(at..at + n),
-                self.orientation.as_flattened().get(at..at + n),
-            ) else {
-                break;
-            };
-            sink(SobelRun {
-                octave: run.octave,
-                y: run.y,
-                x: run.x,
-                magnitude,
-                orientation,
-            });
-            // `n <= run.len`, a u16.
-            run.x = run.x.wrapping_add(n as u16);
-            run.len -= n as u16;
-            if run.len == 0 {
-                self.run_head = Self::wrap(self.run_head + 1);
-                self.run_count -= 1;
+        let mut magnitude = [0; DRAIN_RUN];
+        let mut orientation = [0; DRAIN_RUN];
+        // The run being gathered: its first pixel and its length.
+        let mut first = SobelEntry::default();
+        let mut n = 0;
+        for _ in 0..max.min(self.len) {
+            let Some(p) = self.pop() else { break };
+            let continues = n > 0
+                && n < DRAIN_RUN
+                && (p.octave, p.y) == (first.octave, first.y)
+                && usize::from(p.x) == usize::from(first.x) + n;
+            if !continues {
+                if n > 0 {
+                    sink(gathered(&first, n, &magnitude, &orientation));
+                }
+                first = p;
+                n = 0;
             }
-            self.head = Self::wrap(self.head + n);
-            self.len -= n;
-            left -= n;
+            if let (Some(m), Some(o)) = (magnitude.get_mut(n), orientation.get_mut(n)) {
+                *m = p.magnitude;
+                *o = p.orientation;
+            }
+            n += 1;
         }
+        if n > 0 {
+            sink(gathered(&first, n, &magnitude, &orientation));
+        }
+    }
+}
+
+/// Enqueues pixels into a [`SobelFifo`] ([`SobelFifo::append`]); the FIFO takes them, and
+/// the drop counter what did not fit, when this is dropped.
+pub struct SobelAppend<'a> {
+    /// The FIFO's pixels, two words each.
+    ring: &'a mut [[u32; 2]],
+    /// Ring index of the next free pixel.
+    at: usize,
+    /// Free pixels.
+    free: usize,
+    /// Pixels enqueued, and pixels that did not fit.
+    pushed: usize,
+    lost: usize,
+    len: &'a mut usize,
+    dropped: &'a mut u32,
+}
+
+impl SobelAppend<'_> {
+    /// Enqueues one pixel's words, or counts it when the FIFO is full.
+    #[inline(always)]
+    pub fn push(&mut self, words: [u32; 2]) {
+        if let Some(slot) = self.space().first_mut() {
+            *slot = words;
+            self.commit(1);
+        } else {
+            self.lost += 1;
+        }
+    }
+
+    /// The free pixels from the next one on, up to the end of the ring: fill the front of
+    /// them and [`SobelAppend::commit`] as many. Empty only when the FIFO is full.
+    #[inline(always)]
+    pub fn space(&mut self) -> &mut [[u32; 2]] {
+        let end = self.ring.len().min(self.at + self.free);
+        self.ring.get_mut(self.at..end).unwrap_or_default()
+    }
+
+    /// The first `n` pixels of [`SobelAppend::space`] are filled: enqueues them.
+    #[inline(always)]
+    pub fn commit(&mut self, n: usize) {
+        let n = n.min(self.free);
+        self.at += n;
+        if self.at >= self.ring.len() {
+            self.at -= self.ring.len();
+        }
+        self.free -= n;
+        self.pushed += n;
+    }
+
+    /// Enqueues the leading pixels of `run`, as many as fit; returns how many did.
+    #[inline(always)]
+    pub fn push_run(&mut self, run: SobelRun<'_>) -> usize {
+        let row = SobelRowWords::new(run.octave, run.y);
+        let fit = run.len().min(self.free);
+        let (mut part, _) = run.split_at(fit);
+        // Up to the end of the ring, then from its start.
+        while !part.is_empty() {
+            let space = self.space();
+            let pixels = part.magnitude.iter().zip(part.orientation);
+            let mut written = 0;
+            for (slot, (&m, &o)) in space.iter_mut().zip(pixels) {
+                *slot = row.pixel(part.x.wrapping_add(written as u16), m, o);
+                written += 1;
+            }
+            if written == 0 {
+                break;
+            }
+            self.commit(written);
+            part = part.split_at(written).1;
+        }
+        self.lost += run.len() - fit + part.len();
+        fit - part.len()
+    }
+}
+
+impl Drop for SobelAppend<'_> {
+    fn drop(&mut self) {
+        *self.len += self.pushed;
+        let lost = u32::try_from(self.lost).unwrap_or(u32::MAX);
+        *self.dropped = self.dropped.saturating_add(lost);
+    }
+}
+
+/// The run of `n` pixels from `first` whose values are the front of `magnitude` and
+/// `orientation`.
+fn gathered<'a>(
+    first: &SobelEntry,
+    n: usize,
+    magnitude: &'a [u8],
+    orientation: &'a [u8],
+) -> SobelRun<'a> {
+    SobelRun {
+        octave: first.octave,
+        y: first.y,
+        x: first.x,
+        magnitude: magnitude.get(..n).unwrap_or_default(),
+        orientation: orientation.get(..n).unwrap_or_default(),
     }
 }
 
@@ -307,7 +371,7 @@ mod tests {
     #[derive(Clone, Debug)]
     enum Step {
         /// One pixel.
-        Push(SobelPixel),
+        Push(SobelEntry),
         /// Pixels `x..x + len` of a row, their values drawn from `seed`.
         Run {
             octave: u8,
@@ -318,11 +382,13 @@ mod tests {
         },
         Pop,
         Drain,
+        /// At most this many pixels as words.
+        DrainWords(usize),
     }
 
-    fn pixel() -> impl Strategy<Value = SobelPixel> {
+    fn pixel() -> impl Strategy<Value = SobelEntry> {
         (0u8..4, any::<u8>(), 0u8..64, 0u16..40, 0u16..4).prop_map(
-            |(octave, magnitude, orientation, x, y)| SobelPixel {
+            |(octave, magnitude, orientation, x, y)| SobelEntry {
                 octave,
                 orientation,
                 magnitude,
@@ -339,17 +405,18 @@ mod tests {
                 .prop_map(|(octave, y, x, len, seed)| Step::Run { octave, y, x, len, seed }),
             2 => Just(Step::Pop),
             1 => Just(Step::Drain),
+            1 => (0usize..60).prop_map(Step::DrainWords),
         ]
     }
 
     proptest! {
-        /// Pushes, runs, pops and drains give the pixels, drops and lengths of a plain FIFO
-        /// of pixel records with the same capacity, whatever the wrapping; every run is
-        /// consecutive pixels of one row and none is empty.
+        /// Pushes, runs, pops and drains (as runs or as words) give the pixels, drops and
+        /// lengths of a plain FIFO of pixel records with the same capacity, whatever the
+        /// wrapping; every run is consecutive pixels of one row and none is empty.
         #[test]
         fn runs_hold_the_pixel_stream(steps in prop::collection::vec(step(), 0..200)) {
             let mut runs: SobelFifo<16, 3> = SobelFifo::new();
-            let mut records: LineFifo<SobelPixel, 16, 3> = LineFifo::new(SobelPixel::default());
+            let mut records: LineFifo<SobelEntry, 16, 3> = LineFifo::new(SobelEntry::default());
             for step in steps {
                 match step {
                     Step::Push(p) => {
@@ -381,6 +448,18 @@ mod tests {
                         records.drain_slices(&mut |s| from_records.extend_from_slice(s));
                         prop_assert_eq!(from_runs, from_records);
                     }
+                    Step::DrainWords(max) => {
+                        let mut words = [0; 100];
+                        let n = runs.drain_words(max, &mut words);
+                        let from_words: Vec<SobelEntry> = words
+                            .chunks_exact(2)
+                            .take(n)
+                            .filter_map(|w| sobel_from_words([w[0], w[1]]))
+                            .collect();
+                        let from_records: Vec<SobelEntry> =
+                            core::iter::from_fn(|| records.pop()).take(max.min(50)).collect();
+                        prop_assert_eq!(from_words, from_records);
+                    }
                 }
                 prop_assert_eq!(runs.len(), records.len());
             }
@@ -393,7 +472,7 @@ mod tests {
             let orientation: Vec<u8> = (0..len as u8).map(|i| i % 64).collect();
             let run = SobelRun { magnitude: &magnitude, orientation: &orientation, ..SobelRun::single(&p) };
             let (head, tail) = run.split_at(at);
-            let pixels: Vec<SobelPixel> = head.pixels().chain(tail.pixels()).collect();
+            let pixels: Vec<SobelEntry> = head.pixels().chain(tail.pixels()).collect();
             prop_assert_eq!(pixels, run.pixels().collect::<Vec<_>>());
             prop_assert_eq!(head.len(), at.min(len));
         }

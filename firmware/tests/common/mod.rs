@@ -3,19 +3,19 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use stereocal_firmware::fabric::{run_frame, Config, Extremum, FrontEnd, Overflow, SobelPixel};
+use stereocal_firmware::fabric::{run_frame, Config, Extremum, FrontEnd, Overflow, SobelEntry};
 
-/// Everything a frame produced, each stream stably sorted by octave (raster order kept).
+/// Everything a frame produced, each stream in the order the FIFO gave it.
 #[derive(Debug, PartialEq, Eq)]
 pub struct FrameOut {
     pub points: Vec<Extremum>,
-    pub sobel: Vec<SobelPixel>,
+    pub sobel: Vec<SobelEntry>,
     pub overflow: Overflow,
 }
 
 pub fn run<F: FrontEnd + ?Sized>(fe: &mut F, cfg: &Config, img: &[u8]) -> FrameOut {
     let mut points: Vec<Extremum> = Vec::new();
-    let mut sobel: Vec<SobelPixel> = Vec::new();
+    let mut sobel: Vec<SobelEntry> = Vec::new();
     let overflow = run_frame(
         fe,
         cfg,
@@ -24,8 +24,6 @@ pub fn run<F: FrontEnd + ?Sized>(fe: &mut F, cfg: &Config, img: &[u8]) -> FrameO
         &mut |s| sobel.extend(s.pixels()),
     )
     .expect("frame runs");
-    points.sort_by_key(|p| p.octave);
-    sobel.sort_by_key(|s| s.octave);
     FrameOut {
         points,
         sobel,
@@ -86,6 +84,26 @@ pub fn real_image() -> Option<(Vec<u8>, usize, usize)> {
             None
         }
     }
+}
+
+/// The first left frame of the KITTI drive (1241x376) as 8-bit grey, or `None` (with a loud
+/// message) when the data set is absent outside CI. Under `CI=true` its absence is a failure.
+pub fn kitti_image() -> Option<(Vec<u8>, usize, usize)> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/data/real/kitti_odometry_drive/left/000000.png"
+    );
+    if !std::path::Path::new(path).exists() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "KITTI frame missing under CI=true: {path}"
+        );
+        eprintln!("\n!!! SKIPPING KITTI-frame check: {path} not found !!!\n");
+        return None;
+    }
+    let img = image::open(path).expect("KITTI frame decodes").into_luma8();
+    let (w, h) = img.dimensions();
+    Some((img.into_raw(), w as usize, h as usize))
 }
 
 /// Centre crop / pad (by edge replication) of a grey image to `w x h`.

@@ -1,9 +1,19 @@
-//! The fast-path front end: octaves in cascade, a row per call.
+//! The fast-path front end: octaves in cascade, a row per call, and the FIFOs filled in the
+//! register-level pipeline's order.
+//!
+//! Each call is a line time of the pipeline (`width` clocks). The octaves compute their rows
+//! as soon as the rows they need are in, which is never later than the pipeline hands the
+//! rows' items out while pixels come in; during the flush the pipeline runs an octave `k`
+//! through `2^k` of its rows per line time, so the octaves behind the clock are ticked on
+//! until they are not. Then everything the pipeline pushes before the call's last clock
+//! moves into the FIFOs in the pipeline's order ([`crate::fabric::fast::release`]), and the
+//! frame is done on the line time the pipeline's octaves have drained.
 
 use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::fast::octave::FastOctave;
 use crate::fabric::fast::probe::{NoProbe, Probe};
-use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelPixel};
+use crate::fabric::fast::release::{release, Waiting};
+use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelEntry};
 use crate::fabric::sobel_fifo::SobelRun;
 use crate::fabric::taps::{Taps, GAUSS_TAPS, TAP_BITS};
 
@@ -24,6 +34,8 @@ pub struct FastFrontEnd<
     fifos: OutputFifos<W0>,
     config: Option<Config>,
     rows_in: u16,
+    /// Clocks of the pipeline since the frame's first pixel: the calls so far times `width`.
+    clock: u64,
 }
 
 impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> Default
@@ -78,7 +90,17 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
             fifos: OutputFifos::new(),
             config: None,
             rows_in: 0,
+            clock: 0,
         }
+    }
+
+    /// Items the octaves computed without room to wait for their clock, summed (zero unless
+    /// the fast path ran further ahead of the pipeline than it holds, checked by the tests).
+    pub fn overruns(&self) -> u32 {
+        self.o0.pending().overruns()
+            + self.o1.pending().overruns()
+            + self.o2.pending().overruns()
+            + self.o3.pending().overruns()
     }
 
     /// [`FrontEnd::push_row`] with a probe that sees every scale and DoG row.
@@ -104,19 +126,19 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
         // `row.len() == cfg.width <= W0` (checked above and by validation); `min` keeps the
         // slice below in bounds by construction.
         let w = row.len().min(W0);
-        let Self {
-            o0, input, fifos, ..
-        } = self;
-        let sub = o0.tick(Some(&input[..w]), fifos, probe);
+        let Self { o0, input, .. } = self;
+        let sub = o0.tick(Some(&input[..w]), probe);
         self.cascade(sub, probe);
+        self.line_time(probe);
         Ok(())
     }
 
     /// [`FrontEnd::blank_row`] with a probe.
     pub fn blank_row_probed<P: Probe>(&mut self, probe: &mut P) -> bool {
         if self.config.is_some() {
-            let sub = self.o0.tick(None, &mut self.fifos, probe);
+            let sub = self.o0.tick(None, probe);
             self.cascade(sub, probe);
+            self.line_time(probe);
         }
         self.frame_done()
     }
@@ -127,20 +149,104 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
         if n < 2 {
             return;
         }
-        let sub1 = self
-            .o1
-            .tick(sub0.then(|| self.o0.sub_row()), &mut self.fifos, probe);
+        let sub1 = self.o1.tick(sub0.then(|| self.o0.sub_row()), probe);
         if n < 3 {
             return;
         }
-        let sub2 = self
-            .o2
-            .tick(sub1.then(|| self.o1.sub_row()), &mut self.fifos, probe);
+        let sub2 = self.o2.tick(sub1.then(|| self.o1.sub_row()), probe);
         if n < 4 {
             return;
         }
-        self.o3
-            .tick(sub2.then(|| self.o2.sub_row()), &mut self.fifos, probe);
+        self.o3.tick(sub2.then(|| self.o2.sub_row()), probe);
+    }
+
+    /// Octaves in use.
+    fn octaves(&self) -> usize {
+        self.config.map_or(0, |c| usize::from(c.octaves))
+    }
+
+    /// Ticks octave `k` without input, then hands each subsampled row a tick makes to the
+    /// next octave.
+    fn flush_tick<P: Probe>(&mut self, k: usize, probe: &mut P) {
+        let n = self.octaves();
+        let Self { o0, o1, o2, o3, .. } = self;
+        let mut sub = match k {
+            0 => o0.tick(None, probe),
+            1 => o1.tick(None, probe),
+            2 => o2.tick(None, probe),
+            _ => o3.tick(None, probe),
+        };
+        let mut next = k + 1;
+        while sub && next < n {
+            sub = match next {
+                1 => o1.tick(Some(o0.sub_row()), probe),
+                2 => o2.tick(Some(o1.sub_row()), probe),
+                _ => o3.tick(Some(o2.sub_row()), probe),
+            };
+            next += 1;
+        }
+    }
+
+    /// Whether octave `k` can be ticked without input, and the clock of the first item it
+    /// has not computed ([`FastOctave::frontier`]).
+    fn octave_state(&self, k: usize) -> (bool, Option<u64>) {
+        let feeds = k + 1 < self.octaves();
+        match k {
+            0 => (self.o0.flushing(), self.o0.frontier(feeds)),
+            1 => (self.o1.flushing(), self.o1.frontier(feeds)),
+            2 => (self.o2.flushing(), self.o2.frontier(feeds)),
+            _ => (self.o3.flushing(), self.o3.frontier(feeds)),
+        }
+    }
+
+    /// Pushes every item the pipeline pushes before `until` into the FIFOs.
+    fn release(&mut self, until: u64) {
+        let n = self.octaves();
+        let Self {
+            o0,
+            o1,
+            o2,
+            o3,
+            fifos,
+            ..
+        } = self;
+        let mut octaves: [&mut dyn Waiting<W0>; 4] = [
+            o0.pending_mut(),
+            o1.pending_mut(),
+            o2.pending_mut(),
+            o3.pending_mut(),
+        ];
+        let octaves = octaves.get_mut(..n).unwrap_or_default();
+        release(octaves, until, fifos);
+    }
+
+    /// The end of a line time: catches the octaves up with the pipeline's clock and fills the
+    /// FIFOs up to it.
+    fn line_time<P: Probe>(&mut self, probe: &mut P) {
+        let width = self.config.map_or(0, |c| u64::from(c.width));
+        self.clock += width;
+        let n = self.octaves();
+        // Each round computes a row of some octave: the frame's rows bound the rounds.
+        let rounds = 4 * (usize::from(self.config.map_or(0, |c| c.height)) + 16);
+        for _ in 0..rounds {
+            let mut safe = self.clock;
+            let mut behind = None;
+            for k in 0..n {
+                let (flushing, frontier) = self.octave_state(k);
+                let Some(frontier) = frontier else { continue };
+                safe = safe.min(frontier);
+                if frontier < self.clock && flushing && behind.is_none() {
+                    behind = Some(k);
+                }
+            }
+            // Everything before the first item not computed is final.
+            self.release(safe);
+            match behind {
+                Some(k) => self.flush_tick(k, probe),
+                None => break,
+            }
+        }
+        self.release(self.clock);
     }
 }
 
@@ -155,6 +261,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.o3.start(config);
         self.config = Some(*config);
         self.rows_in = 0;
+        self.clock = 0;
         Ok(())
     }
 
@@ -169,24 +276,26 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
     fn frame_done(&self) -> bool {
         let Some(cfg) = self.config else { return false };
         let n = cfg.octaves;
+        let t = self.clock;
         self.rows_in == cfg.height
-            && self.o0.done()
-            && (n < 2 || self.o1.done())
-            && (n < 3 || self.o2.done())
-            && (n < 4 || self.o3.done())
+            && self.o0.drained_by(t)
+            && (n < 2 || self.o1.drained_by(t))
+            && (n < 3 || self.o2.drained_by(t))
+            && (n < 4 || self.o3.drained_by(t))
     }
 
     fn reset(&mut self) {
         self.fifos.clear();
         self.config = None;
         self.rows_in = 0;
+        self.clock = 0;
     }
 
     fn pop_point(&mut self) -> Option<Extremum> {
         self.fifos.pop_point()
     }
 
-    fn pop_sobel(&mut self) -> Option<SobelPixel> {
+    fn pop_sobel(&mut self) -> Option<SobelEntry> {
         self.fifos.pop_sobel()
     }
 
@@ -208,5 +317,9 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
 
     fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
         self.fifos.drain_sobel(max, sink);
+    }
+
+    fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
+        self.fifos.drain_sobel_words(max, words)
     }
 }

@@ -2,13 +2,16 @@
 //!
 //! Same integers as the register-level model (plain multiplies replace the LUT distributed
 //! arithmetic: `Σ_b LUT[bits_b] << b` is exactly `Σ_j tap_j · s_j`), same borders, same
-//! stream contents per octave; only the interleaving of octaves in the FIFOs differs.
-//! `tests/bit_exact.rs` proves the equality on random and real images.
+//! streams, pushed into the FIFOs in the pipeline's order at the pipeline's line times
+//! ([`pending`], [`release`]). `tests/bit_exact.rs` proves the streams equal on random and
+//! real images, `tests/fifo_order.rs` the FIFOs' contents and counters.
 
 mod filter;
 mod frontend;
 mod octave;
+mod pending;
 mod probe;
+mod release;
 #[cfg(target_arch = "x86_64")]
 mod simd;
 

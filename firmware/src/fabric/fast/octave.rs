@@ -13,9 +13,11 @@ use crate::fabric::config::Config;
 use crate::fabric::edge::passes_edge_test;
 use crate::fabric::extrema::{is_extremum, Cube};
 use crate::fabric::fast::filter::{column_filter, cordic_row, dog_row, row_filter, sobel_row};
+use crate::fabric::fast::pending::Pending;
 use crate::fabric::fast::probe::Probe;
 use crate::fabric::geometry::octave_dims;
-use crate::fabric::output::{Extremum, OutputFifos};
+use crate::fabric::latency::octave_to_next;
+use crate::fabric::output::Extremum;
 use crate::fabric::refine::refine;
 use crate::fabric::taps::Taps;
 
@@ -49,8 +51,8 @@ pub(crate) struct FastOctave<const W: usize> {
     sobel_rows: u16,
     sx: [i32; W],
     sy: [i32; W],
-    magnitude: [u8; W],
-    orientation: [u8; W],
+    /// Sobel rows and points computed ahead of the register-level pipeline.
+    pending: Pending<W>,
     /// The subsampled G3 row handed to the next octave.
     sub: [u16; W],
     sub_len: usize,
@@ -75,8 +77,7 @@ impl<const W: usize> FastOctave<W> {
             sobel_rows: 0,
             sx: [0; W],
             sy: [0; W],
-            magnitude: [0; W],
-            orientation: [0; W],
+            pending: Pending::new(index),
             sub: [0; W],
             sub_len: 0,
         }
@@ -91,6 +92,52 @@ impl<const W: usize> FastOctave<W> {
         self.count = [GaussCount::default(); 4];
         self.sobel_rows = 0;
         self.sub_len = 0;
+        self.pending.start(config);
+    }
+
+    /// What the octave computed and the pipeline has not handed out yet.
+    pub(crate) fn pending(&self) -> &Pending<W> {
+        &self.pending
+    }
+
+    /// The same, to hand out.
+    pub(crate) fn pending_mut(&mut self) -> &mut Pending<W> {
+        &mut self.pending
+    }
+
+    /// Whether the register-level pipeline's octave has drained before clock `clock`: the
+    /// octave computed everything, handed everything out, and the pipeline's last item of
+    /// the frame left before that clock.
+    pub(crate) fn drained_by(&self, clock: u64) -> bool {
+        self.done() && self.pending.is_empty() && self.pending.drained_clock() < clock
+    }
+
+    /// Whether the input is complete and there is still something to compute: a tick
+    /// without input makes progress.
+    pub(crate) fn flushing(&self) -> bool {
+        self.rows_in == self.height && !self.done()
+    }
+
+    /// Clock at which the register-level pipeline hands out the first item this octave has
+    /// not computed yet: its next Sobel row, its next row of points, or, when `feeds` (an
+    /// octave follows), its next subsampled row; `None` when everything is computed.
+    pub(crate) fn frontier(&self, feeds: bool) -> Option<u64> {
+        let (w, h) = (u64::from(self.width), self.height);
+        let g3 = self.count[3].rows_out;
+        // The extremum scan of row `r - 1` runs with DoG (and G3) row `r >= 2`.
+        let scan = g3.max(2) - 1;
+        let sub = g3 + (g3 & 1);
+        let first = [
+            (self.sobel_rows < h)
+                .then(|| u64::from(self.sobel_rows) * w + self.pending.sobel_latency()),
+            (scan + 2 <= h).then(|| u64::from(scan) * w + 1 + self.pending.point_latency()),
+            (feeds && sub < h)
+                .then(|| u64::from(sub) * w + u64::from(octave_to_next(self.width, self.index))),
+        ]
+        .into_iter()
+        .flatten()
+        .min()?;
+        Some(self.pending.clock_of(first))
     }
 
     pub(crate) fn done(&self) -> bool {
@@ -112,12 +159,7 @@ impl<const W: usize> FastOctave<W> {
 
     /// One row tick: a real row, or `None` (a phantom tick once the input is complete).
     /// Returns whether a subsampled row for the next octave was produced.
-    pub(crate) fn tick<const W0: usize, P: Probe>(
-        &mut self,
-        input: Option<&[u16]>,
-        out: &mut OutputFifos<W0>,
-        probe: &mut P,
-    ) -> bool {
+    pub(crate) fn tick<P: Probe>(&mut self, input: Option<&[u16]>, probe: &mut P) -> bool {
         if input.is_some() {
             self.rows_in += 1;
         } else if self.rows_in < self.height {
@@ -187,11 +229,11 @@ impl<const W: usize> FastOctave<W> {
             }
         }
 
-        self.sobel_tick(out);
+        self.sobel_tick();
 
         self.sub_len = 0;
         if let Some(r) = emitted[3] {
-            self.dog_and_extrema(r, out, probe);
+            self.dog_and_extrema(r, probe);
             if r & 1 == 0 {
                 let g3 = &self.scale[3][r as usize % RING][..w];
                 self.sub_len = w.div_ceil(2);
@@ -206,7 +248,8 @@ impl<const W: usize> FastOctave<W> {
 
     /// Emits at most one Sobel row: row `s` once scale row `s + 1` exists, or once the scale
     /// image is complete.
-    fn sobel_tick<const W0: usize>(&mut self, out: &mut OutputFifos<W0>) {
+    /// A row without room to wait in ([`Pending::sobel_slot`]) is skipped, counted there.
+    fn sobel_tick(&mut self) {
         let s = self.config.sobel_scale as usize & 3;
         let (w, h) = (self.row_len(), self.height);
         let have = self.count[s].rows_out;
@@ -222,23 +265,15 @@ impl<const W: usize> FastOctave<W> {
             &mut self.sx[..w],
             &mut self.sy[..w],
         );
-        cordic_row(
-            &self.sx[..w],
-            &self.sy[..w],
-            &mut self.magnitude[..w],
-            &mut self.orientation[..w],
-        );
-        out.push_sobel_row(self.index, r, &self.magnitude[..w], &self.orientation[..w]);
+        if let Some((magnitude, orientation)) = self.pending.sobel_slot(r) {
+            cordic_row(&self.sx[..w], &self.sy[..w], magnitude, orientation);
+            self.pending.sobel_done(r);
+        }
         self.sobel_rows += 1;
     }
 
     /// DoG row `r`, then the extremum scan of row `r - 1`.
-    fn dog_and_extrema<const W0: usize, P: Probe>(
-        &mut self,
-        r: u16,
-        out: &mut OutputFifos<W0>,
-        probe: &mut P,
-    ) {
+    fn dog_and_extrema<P: Probe>(&mut self, r: u16, probe: &mut P) {
         let w = self.row_len();
         let slot = r as usize % RING;
         for i in 0..3 {
@@ -263,23 +298,28 @@ impl<const W: usize> FastOctave<W> {
             .each_ref()
             .map(|d| rows.map(|y| d.get(y).and_then(|r| r.get(..w)).unwrap_or(&[])));
         let index = self.index;
+        let pending = &mut self.pending;
         let mut verify = |x: usize| {
             let c = cube(&planes, x);
-            if !is_extremum(&c, thr) || !passes_edge_test(&c[1], edge_ratio) {
+            if !is_extremum(&c, thr) {
                 return;
             }
-            if let Some([dx, dy, ds]) = refine(&c, max_offset) {
-                out.push_point(Extremum {
-                    x: x as u16,
-                    y: yc,
-                    octave: index,
-                    scale: 1,
-                    dx,
-                    dy,
-                    ds,
-                    dog: c[1][1][1],
-                });
+            let x = x as u16;
+            if !passes_edge_test(&c[1], edge_ratio) {
+                pending.candidate(x, yc, false, None);
+                return;
             }
+            let point = refine(&c, max_offset).map(|[dx, dy, ds]| Extremum {
+                x,
+                y: yc,
+                octave: index,
+                scale: 1,
+                dx,
+                dy,
+                ds,
+                dog: c[1][1][1],
+            });
+            pending.candidate(x, yc, true, point);
         };
         // Blocks of centres are screened branch-free on necessary conditions, and only the
         // survivors take the 26-neighbour test on their cube; the last centres, fewer than a
