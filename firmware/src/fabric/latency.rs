@@ -96,7 +96,7 @@ pub const fn enabled_run(width: u16, height: u16, k: u8, m: u64) -> ClockRun {
     let (w, h) = octave_dims(width, height, k);
     let total = w as u64 * h as u64;
     // An empty octave (a zero-width frame, which no configuration allows) has no samples.
-    if total == 0 {
+    if w == 0 || h == 0 {
         return ClockRun {
             clock: 0,
             stride: 1,

@@ -249,6 +249,11 @@ fn periods(
                 }
             }
         }
+        // Two octaves in step put at least two pixels into a period; the soft-core build
+        // proves it has no panicking path, so the divisor says so in its type.
+        let Some(period) = core::num::NonZeroUsize::new(len) else {
+            return Periods::None;
+        };
         let pattern = pattern.get(..len).unwrap_or_default();
         let mut next = taken.map(|t| t as usize);
         let mut left = count as usize;
@@ -256,7 +261,7 @@ fn periods(
             // As many whole periods as fit before the end of the ring, written in place; a
             // period across the end, or into a full FIFO, pixel by pixel.
             let space = out.space();
-            let fit = (space.len() / len).min(left);
+            let fit = (space.len() / period).min(left);
             if fit == 0 {
                 for &j in pattern {
                     let j = usize::from(j);
@@ -274,9 +279,12 @@ fn periods(
                 let (Some(places), Some(&per)) = (places.get(j), per.get(j)) else {
                     continue;
                 };
-                let Some(places) = places.get(..per).filter(|p| !p.is_empty()) else {
+                let (Some(places), Some(per)) =
+                    (places.get(..per), core::num::NonZeroUsize::new(per))
+                else {
                     continue;
                 };
+                let per = per.get();
                 let span = *i..*i + fit * per;
                 let (Some(magnitude), Some(orientation)) = (
                     head.pixels.magnitude.get(span.clone()),
@@ -288,7 +296,9 @@ fn periods(
                 let pixels = magnitude
                     .chunks_exact(per)
                     .zip(orientation.chunks_exact(per));
-                for (block, (magnitude, orientation)) in blocks.chunks_exact_mut(len).zip(pixels) {
+                for (block, (magnitude, orientation)) in
+                    blocks.chunks_exact_mut(period.get()).zip(pixels)
+                {
                     for ((&at, &m), &o) in places.iter().zip(magnitude).zip(orientation) {
                         if let Some(slot) = block.get_mut(usize::from(at)) {
                             *slot = head.words.pixel(x, m, o);
