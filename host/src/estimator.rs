@@ -7,19 +7,23 @@
 //! starting point and a Cauchy-weighted Gauss-Newton refinement over all matches gives the
 //! answer and its uncertainty.
 
+use std::sync::{Arc, Mutex, OnceLock};
+
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 use stereocal_hdl::regs::MAX_OCTAVES;
 
 use crate::calib::Calibration;
 use crate::descriptor::{describe, DescriptorConfig};
+use crate::epipolar_band::{EpipolarBand, PoseRange};
 use crate::essential::constrained::{self, VergeAngles};
 use crate::essential::general::{self, RelativePose, YawPitchRoll};
 use crate::essential::{cauchy_cost, Correspondence, EssentialError, RefineConfig};
+use crate::essential::{rot_x, rot_y, rot_z};
 use crate::features::{FeatureFrame, Keypoint, SobelPlane};
-use crate::matching::{match_descriptors, Match, MatchConfig};
+use crate::matching::{match_descriptors, Gate, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
-use crate::subpixel::{guided_pair, refine_pair, RefinedPair, SubpixelConfig};
+use crate::subpixel::{guided_pair, refine_pair, RefinedPair, SubpixelConfig, Warp};
 
 /// A matched point pair in full-resolution pixels: (left, right).
 pub type PixelPair = ([f64; 2], [f64; 2]);
@@ -32,6 +36,20 @@ pub enum Model {
     Constrained,
     /// Free relative rotation and baseline direction (heads that also tilt).
     General,
+}
+
+impl Model {
+    /// The relative pitch and roll, beyond the calibration's, that the matching gate lets
+    /// through (degrees). The constrained model explains none: a head whose calibration misses
+    /// more than a degree of either is outside what it can fit, so a wider gate would only let
+    /// in false candidates. The general model fits them, for heads assembled within a few
+    /// degrees.
+    pub fn misalignment_allowance_deg(self) -> f64 {
+        match self {
+            Model::Constrained => 1.0,
+            Model::General => 3.0,
+        }
+    }
 }
 
 /// Settings of the whole per-frame estimate.
@@ -51,6 +69,9 @@ pub struct EstimatorConfig {
     pub min_matches: usize,
     /// Guided matching of the keypoints the descriptors left unmatched (needs Sobel planes).
     pub guided: Option<GuidedConfig>,
+    /// Relative pitch and roll beyond the calibration's that the epipolar gate allows
+    /// (degrees); `None`: the model's own (see [`Model::misalignment_allowance_deg`]).
+    pub misalignment_allowance_deg: Option<f64>,
     /// Weigh each refined match by the inverse variance of its vertical position,
     /// `1 / max(σ_v, floor)²`, with this floor in pixels; `None`: every match alike.
     ///
@@ -97,6 +118,7 @@ impl Default for EstimatorConfig {
             model: Model::Constrained,
             min_matches: 12,
             guided: Some(GuidedConfig::default()),
+            misalignment_allowance_deg: None,
             weight_floor_px: Some(0.02),
         }
     }
@@ -123,6 +145,9 @@ pub struct FrameEstimate {
     pub angles: Option<VergeAngles>,
     /// General model: `R_01` angles. Constrained model: `None`.
     pub pose: Option<YawPitchRoll>,
+    /// The two yaws (the general model's: its verge split as its baseline direction says),
+    /// where the next frame's matching band is centred (see [`VergeEstimator::estimate_near`]).
+    pub yaws: VergeAngles,
     /// Descriptor matches found.
     pub matches: usize,
     /// Matches that entered the estimate (after sub-pixel rejection).
@@ -148,15 +173,100 @@ pub struct FrameEstimate {
 pub struct VergeEstimator {
     calib: Calibration,
     config: EstimatorConfig,
+    /// The epipolar band over the head's whole range for the image size first seen: a head's
+    /// frames keep their size.
+    band: OnceLock<((u32, u32), Arc<EpipolarBand>)>,
+    /// The band [`VergeEstimator::estimate_near`] last used, with its image size and rounded
+    /// yaws: a head that holds its verge reuses it frame after frame.
+    near_band: Arc<Mutex<Option<(NearKey, Arc<EpipolarBand>)>>>,
+}
+
+/// What a band near the last estimate is built for: image size and yaws in [`YAW_QUANTUM_DEG`]
+/// steps.
+type NearKey = (u32, u32, i64, i64);
+
+/// The step the yaws are rounded to before a band is built around them: a head that holds
+/// still keeps its rounded yaws, so its band is built once, and the band's reach grows by one
+/// step to cover the rounding (half a step per yaw, a whole one for the verge).
+const YAW_QUANTUM_DEG: f64 = 0.5;
+
+/// How far the head may turn between two frames for [`VergeEstimator::estimate_near`]'s band
+/// (degrees, each yaw and the verge): a verge motor's fast turn (150 °/s, a CeDAR-class head)
+/// covers 5° between frames at 30 fps. A faster move loses the image corners' matches for a
+/// frame (the centre's rows barely depend on the verge), or the frame falls back to the whole
+/// range.
+pub const REACH_DEG: f64 = 5.0;
+
+/// How far, in full-resolution pixels, a keypoint's row may be from its true one on each side:
+/// the fabric's quadratic fit places an extremum within half a sample of its octave's grid,
+/// and both keypoints of a match carry that error.
+fn localisation_px(k: &Keypoint) -> f32 {
+    f32::from(1u16 << k.octave.min(15))
 }
 
 impl VergeEstimator {
     pub fn new(calib: Calibration, config: EstimatorConfig) -> Self {
-        Self { calib, config }
+        Self {
+            calib,
+            config,
+            band: OnceLock::new(),
+            near_band: Arc::default(),
+        }
     }
 
-    pub fn config(&self) -> &EstimatorConfig {
-        &self.config
+    fn misalignment_allowance_deg(&self) -> f64 {
+        self.config
+            .misalignment_allowance_deg
+            .unwrap_or(self.config.model.misalignment_allowance_deg())
+    }
+
+    /// The epipolar band of `width` x `height` frames over the poses near `near` (see
+    /// [`YAW_QUANTUM_DEG`]), or over the head's whole range when `None`.
+    fn band(&self, width: u32, height: u32, near: Option<VergeAngles>) -> Arc<EpipolarBand> {
+        let allowance = self.misalignment_allowance_deg();
+        let Some(yaws) = near else {
+            let range = PoseRange::verge_head(allowance);
+            let build = || Arc::new(EpipolarBand::new(&self.calib, width, height, &range));
+            let (size, band) = self.band.get_or_init(|| ((width, height), build()));
+            return if *size == (width, height) {
+                band.clone()
+            } else {
+                build()
+            };
+        };
+        let step = |a: f64| (a.to_degrees() / YAW_QUANTUM_DEG).round() as i64;
+        let key = (width, height, step(yaws.alpha_l), step(yaws.alpha_r));
+        // A poisoned lock only means another thread panicked while building: build anew.
+        let mut cache = self.near_band.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, band)) = cache.as_ref().filter(|(k, _)| *k == key) {
+            return band.clone();
+        }
+        let rounded = |s: i64| (s as f64 * YAW_QUANTUM_DEG).to_radians();
+        let range = PoseRange::around(
+            VergeAngles::new(rounded(key.2), rounded(key.3)),
+            REACH_DEG + YAW_QUANTUM_DEG,
+            allowance,
+        );
+        let band = Arc::new(EpipolarBand::new(&self.calib, width, height, &range));
+        *cache = Some((key, band.clone()));
+        band
+    }
+
+    /// The map `K_r R K_l⁻¹` of left pixels to right pixels that turning the cameras to
+    /// `near`'s yaws (the calibration's when `None`), with the calibration's pitch and roll,
+    /// makes for distant points: what the sub-pixel refinement warps its windows by.
+    fn rotation_homography(&self, near: Option<VergeAngles>) -> Matrix3<f64> {
+        let e = &self.calib.extrinsics;
+        let yaws = near.unwrap_or_else(|| VergeAngles::from_extrinsics(e));
+        let right =
+            rot_y(yaws.alpha_r) * rot_x(e.pitch_deg.to_radians()) * rot_z(e.roll_deg.to_radians());
+        let k = |c: &crate::calib::CameraIntrinsics| {
+            Matrix3::new(c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0)
+        };
+        let k_left_inv = k(&self.calib.left)
+            .try_inverse()
+            .unwrap_or_else(Matrix3::identity);
+        k(&self.calib.right) * right.transpose() * rot_y(yaws.alpha_l) * k_left_inv
     }
 
     /// Matches two frames and returns the matched full-resolution point pairs, refined to
@@ -166,20 +276,31 @@ impl VergeEstimator {
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
+        near: Option<VergeAngles>,
     ) -> (Vec<Match>, Vec<(PixelPair, Option<f32>)>) {
         // The two images and the matches are independent: both cores work on them.
         let (dl, dr) = rayon::join(
             || describe(left, &self.config.descriptor),
             || describe(right, &self.config.descriptor),
         );
-        let matches = match_descriptors(
-            &dl,
-            left.keypoints(),
-            &dr,
-            right.keypoints(),
-            &self.config.matching,
-        );
+        let config = &self.config.matching;
+        let matches = match config.gate {
+            Gate::Epipolar => {
+                let band = self.band(left.width, left.height, near);
+                let rows = |k: &Keypoint| band.rows(k.x, k.y, localisation_px(k));
+                match_descriptors(&dl, left.keypoints(), &dr, right.keypoints(), config, &rows)
+            }
+            Gate::Rows(px) => {
+                let rows = |k: &Keypoint| [k.y - px, k.y + px];
+                match_descriptors(&dl, left.keypoints(), &dr, right.keypoints(), config, &rows)
+            }
+            Gate::Off => {
+                let rows = |_: &Keypoint| [f32::NEG_INFINITY, f32::INFINITY];
+                match_descriptors(&dl, left.keypoints(), &dr, right.keypoints(), config, &rows)
+            }
+        };
         let planes = left.plane(0).zip(right.plane(0));
+        let homography = self.rotation_homography(near);
         let pairs = matches
             .par_iter()
             .filter_map(|m| {
@@ -187,7 +308,8 @@ impl VergeEstimator {
                 let kr = right.keypoints()[m.right as usize];
                 match (self.config.subpixel, planes) {
                     (Some(cfg), Some((pl, pr))) => {
-                        refine_pair(pl, pr, [kl.x, kl.y], [kr.x, kr.y], &cfg).map(refined)
+                        let warp = local_warp(&homography, kl.x, kl.y);
+                        refine_pair(pl, pr, [kl.x, kl.y], [kr.x, kr.y], &warp, &cfg).map(refined)
                     }
                     _ => Some((
                         ([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64]),
@@ -199,20 +321,55 @@ impl VergeEstimator {
         (matches, pairs)
     }
 
-    /// Estimates the verge angle of one frame pair.
+    /// Estimates the verge angle of one frame pair, matching over the head's whole range of
+    /// poses, then again near the yaws that gives.
     pub fn estimate(
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> Result<FrameEstimate, EstimateError> {
-        let (matches, mut pairs) = self.point_pairs(left, right);
+        let first = self.estimate_within(left, right, None)?;
+        // Without yaws to start from the windows were warped for the calibrated head; with the
+        // yaws found, the pair is matched and refined again in their band and through their
+        // warp.
+        Ok(self
+            .estimate_within(left, right, Some(first.yaws))
+            .unwrap_or(first))
+    }
+
+    /// Estimates the verge angle of one frame pair whose head is expected near `yaws` (the
+    /// last estimate's): matching looks only in the band of the poses within
+    /// [`REACH_DEG`] of them, which near the image corners is much narrower than the whole
+    /// range's, so fewer false candidates compete with the true one. When that gives no
+    /// estimate (the head moved further) the whole range is tried.
+    pub fn estimate_near(
+        &self,
+        left: &FeatureFrame,
+        right: &FeatureFrame,
+        yaws: Option<VergeAngles>,
+    ) -> Result<FrameEstimate, EstimateError> {
+        let Some(yaws) = yaws else {
+            return self.estimate(left, right);
+        };
+        self.estimate_within(left, right, Some(yaws))
+            .or_else(|_| self.estimate(left, right))
+    }
+
+    fn estimate_within(
+        &self,
+        left: &FeatureFrame,
+        right: &FeatureFrame,
+        near: Option<VergeAngles>,
+    ) -> Result<FrameEstimate, EstimateError> {
+        let (matches, mut pairs) = self.point_pairs(left, right, near);
         if let (Some(g), Some(sub), Some(pl), Some(pr)) = (
             self.config.guided,
             self.config.subpixel,
             left.plane(0),
             right.plane(0),
         ) {
-            let extra = guided_pairs(left, &matches, &pairs, pl, pr, &g, &sub);
+            let homography = self.rotation_homography(near);
+            let extra = guided_pairs(left, &matches, &pairs, pl, pr, &homography, &g, &sub);
             pairs.extend(extra);
         }
         let weights = match_weights(&pairs, self.config.weight_floor_px);
@@ -295,6 +452,7 @@ impl VergeEstimator {
             sigma_deg: cfit.verge_sigma.to_degrees(),
             angles: Some(cfit.angles),
             pose: None,
+            yaws: cfit.angles,
             matches: pairs.len(),
             used: pairs.len(),
             inliers: cfit.inlier_count(),
@@ -327,6 +485,7 @@ impl VergeEstimator {
             est.angles = None;
             est.consistent = Vec::new();
             est.pose = Some(gfit.pose.yaw_pitch_roll());
+            est.yaws = gfit.pose.yaws();
             est.inliers = gfit.inlier_count();
             est.residual_px = gfit.residual_sigma * focal;
         }
@@ -362,6 +521,17 @@ fn lowest_cost<F>(
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, f)| f)
         .ok_or(first_err.unwrap_or(EssentialError::Degenerate))
+}
+
+/// The local linear map (Jacobian) of the homography `h` at the left pixel (`x`, `y`): how a
+/// window around it appears in the right image.
+fn local_warp(h: &Matrix3<f64>, x: f32, y: f32) -> Warp {
+    let (x, y) = (f64::from(x), f64::from(y));
+    let w = h[(2, 0)] * x + h[(2, 1)] * y + h[(2, 2)];
+    let u = (h[(0, 0)] * x + h[(0, 1)] * y + h[(0, 2)]) / w;
+    let v = (h[(1, 0)] * x + h[(1, 1)] * y + h[(1, 2)]) / w;
+    let j = |r: usize, c: usize, p: f64| ((h[(r, c)] - p * h[(2, c)]) / w) as f32;
+    [j(0, 0, u), j(0, 1, u), j(1, 0, v), j(1, 1, v)]
 }
 
 /// A refined match as the estimator takes it: the pixel pair and its vertical 1-σ.
@@ -405,13 +575,16 @@ fn per_octave(octaves: impl Iterator<Item = u8>) -> Vec<usize> {
     counts
 }
 
-/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]).
+/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]),
+/// refined through `homography`'s local warp.
+#[allow(clippy::too_many_arguments)]
 fn guided_pairs(
     left: &FeatureFrame,
     matches: &[Match],
     pairs: &[(PixelPair, Option<f32>)],
     pl: &SobelPlane,
     pr: &SobelPlane,
+    homography: &Matrix3<f64>,
     g: &GuidedConfig,
     sub: &SubpixelConfig,
 ) -> Vec<(PixelPair, Option<f32>)> {
@@ -465,7 +638,8 @@ fn guided_pairs(
                     kp.x + median(|(l, r)| r[0] - l[0]),
                     kp.y + median(|(l, r)| r[1] - l[1]),
                 ];
-                guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, sub).map(|r| (kp, r))
+                let warp = local_warp(homography, kp.x, kp.y);
+                guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, &warp, sub).map(|r| (kp, r))
             },
         )
         .flatten()

@@ -4,9 +4,14 @@
 //! pixel at the image corners, while DoG extrema are localised to a few tenths of a pixel
 //! (and at 2ᵒ-pixel steps in octave `o`). So each match is re-localised: the left point is
 //! snapped to its nearest octave-0 pixel, and the right point is moved to where a window of
-//! the right magnitude plane best matches the left window (Lucas-Kanade, translation only,
-//! inverse-compositional, with gain and offset compensation, since the two cameras' exposures
-//! differ). Only the geometry of the point pair matters to the estimator, so fixing the left
+//! the right magnitude plane best matches the left window (Lucas-Kanade, inverse-compositional,
+//! with gain and offset compensation, since the two cameras' exposures differ). The right
+//! window is not a translated copy of the left one on a verged head: turning a camera by the
+//! verge maps its image by a homography, which stretches and shears a window by several per
+//! cent at 10-20° (the horizontal scale is 1/cos² of the angle off the axis), and a
+//! translation fitted across such a window moves with the texture's asymmetry. So the right
+//! window is sampled through the homography's local linear map (the caller's [`Warp`]) and
+//! only its translation is estimated. Only the geometry of the point pair matters to the estimator, so fixing the left
 //! point at an integer pixel loses nothing and keeps the interpolation on one side.
 //!
 //! Matches whose window has too little vertical structure (the vertical position would be
@@ -44,6 +49,19 @@ impl Default for SubpixelConfig {
     }
 }
 
+/// The local linear map from the left window's offsets to the right window's, row-major:
+/// `[dx_r, dy_r] = [[a, b], [c, d]] · [dx_l, dy_l]`. The identity on a parallel head.
+pub type Warp = [f32; 4];
+
+/// The identity [`Warp`]: the right window a translated copy of the left one.
+pub const IDENTITY: Warp = [1.0, 0.0, 0.0, 1.0];
+
+/// A warp whose largest displacement of a window sample, against the identity's, stays below
+/// this (pixels) is sampled as the identity: a few hundredths of a pixel at the window's edge
+/// are below what the refinement resolves (the u8 magnitudes limit it to about that), and the
+/// translated window's shared interpolation weights make it several times faster.
+const WARP_NEGLIGIBLE_PX: f32 = 0.01;
+
 /// A refined point pair in octave-0 (full-resolution) pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefinedPair {
@@ -58,7 +76,7 @@ pub struct RefinedPair {
 /// fractional weights: the bounds are checked once and the loop is four loads and a blend,
 /// over four equal-length row slices so that it compiles to vector code without bounds checks.
 /// `None` when the window (plus its interpolation neighbours) leaves the plane.
-fn sample_window(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> Option<()> {
+fn sample_translated(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> Option<()> {
     let (w, h) = (p.width() as i32, p.height() as i32);
     let (x0, y0) = ((x - half as f32).floor(), (y - half as f32).floor());
     let (ix, iy) = (x0 as i32, y0 as i32);
@@ -85,6 +103,52 @@ fn sample_window(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> 
     Some(())
 }
 
+/// [`sample_translated`] through `warp`: sample `(c, r)` of the window (offsets from its centre)
+/// is taken at `(x, y) + warp · (c, r)`, each sample with its own interpolation weights.
+fn sample_warped(
+    p: &SobelPlane,
+    x: f32,
+    y: f32,
+    half: i32,
+    warp: &Warp,
+    out: &mut [f32],
+) -> Option<()> {
+    let [a, b, c, d] = *warp;
+    let h = half as f32;
+    // The window's extreme sample positions are at its corners (the map is linear).
+    let reach_x = (a.abs() + b.abs()) * h;
+    let reach_y = (c.abs() + d.abs()) * h;
+    let (w, hh) = (p.width() as f32, p.height() as f32);
+    if !(x.is_finite() && y.is_finite())
+        || x - reach_x < 0.0
+        || y - reach_y < 0.0
+        || x + reach_x + 1.0 >= w
+        || y + reach_y + 1.0 >= hh
+    {
+        return None;
+    }
+    let (m, stride) = (p.magnitude(), p.width() as usize);
+    let side = (2 * half + 1) as usize;
+    for (r, row_out) in out.chunks_exact_mut(side).enumerate() {
+        let dy = r as f32 - h;
+        let (mut sx, mut sy) = (x - a * h + b * dy, y - c * h + d * dy);
+        for o in row_out.iter_mut() {
+            let (fx, fy) = (sx.floor(), sy.floor());
+            let (ix, iy) = (fx as usize, fy as usize);
+            let (tx, ty) = (sx - fx, sy - fy);
+            let at = iy * stride + ix;
+            let (p00, p01) = (f32::from(m[at]), f32::from(m[at + 1]));
+            let (p10, p11) = (f32::from(m[at + stride]), f32::from(m[at + stride + 1]));
+            let top = p00 + tx * (p01 - p00);
+            let bottom = p10 + tx * (p11 - p10);
+            *o = top + ty * (bottom - top);
+            sx += a;
+            sy += c;
+        }
+    }
+    Some(())
+}
+
 thread_local! {
     /// [`refine_pair`]'s working arrays, kept per thread between calls: a match needs seven
     /// window-sized arrays, and taking them from here spares their allocation (or the zeroing
@@ -93,12 +157,14 @@ thread_local! {
     static SCRATCH: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
 }
 
-/// Refines one match: `left` / `right` in full-resolution pixels. `None` when rejected.
+/// Refines one match: `left` / `right` in full-resolution pixels, `warp` the local map from the
+/// left window to the right one ([`IDENTITY`] on a parallel head). `None` when rejected.
 pub fn refine_pair(
     left_plane: &SobelPlane,
     right_plane: &SobelPlane,
     left: [f32; 2],
     right: [f32; 2],
+    warp: &Warp,
     config: &SubpixelConfig,
 ) -> Option<RefinedPair> {
     let half = i32::try_from(config.half_window).ok()?;
@@ -114,12 +180,16 @@ pub fn refine_pair(
     if scratch.len() < len {
         scratch.resize(len, 0.0);
     }
+    let [a, b, c, d] = *warp;
+    let off = ((a - 1.0).abs() + b.abs() + c.abs() + (d - 1.0).abs()) * half as f32;
+    let warp = (off >= WARP_NEGLIGIBLE_PX).then_some(warp);
     let refined = refine_in(
         left_plane,
         right_plane,
         left,
         [lx, ly],
         right,
+        warp,
         config,
         &mut scratch[..len],
     );
@@ -170,16 +240,24 @@ fn mean_and_norm(window: &[f32], squares: &mut [f32]) -> (f32, f32) {
 }
 
 /// [`refine_pair`] with the left point snapped to `[lx, ly]`, whose window plus a one-pixel
-/// border lies inside the plane, and `buffer` [`SCRATCH_ARRAYS`] window sizes long.
+/// border lies inside the plane, `warp` `None` for the identity, and `buffer`
+/// [`SCRATCH_ARRAYS`] window sizes long.
+#[allow(clippy::too_many_arguments)]
 fn refine_in(
     left_plane: &SobelPlane,
     right_plane: &SobelPlane,
     left: [f32; 2],
     [lx, ly]: [i32; 2],
     right: [f32; 2],
+    warp: Option<&Warp>,
     config: &SubpixelConfig,
     buffer: &mut [f32],
 ) -> Option<RefinedPair> {
+    let sample = |x: f32, y: f32, out: &mut [f32]| match warp {
+        Some(w) => sample_warped(right_plane, x, y, config.half_window as i32, w, out),
+        None => sample_translated(right_plane, x, y, config.half_window as i32, out),
+    };
+    let [a, b, c, d] = *warp.unwrap_or(&IDENTITY);
     let half = config.half_window as i32;
     let side = (2 * half + 1) as usize;
     let n = side * side;
@@ -230,15 +308,13 @@ fn refine_in(
     if det.is_nan() || det <= 1e-6 * (hxx + hyy).powi(2) || t_norm <= 0.0 {
         return None;
     }
-    // Start: the right point shifted by the same amount the left one was snapped.
-    let start = [
-        right[0] + (lx as f32 - left[0]),
-        right[1] + (ly as f32 - left[1]),
-    ];
+    // Start: the right point shifted by what the left one was snapped, mapped by the warp.
+    let (sx, sy) = (lx as f32 - left[0], ly as f32 - left[1]);
+    let start = [right[0] + a * sx + b * sy, right[1] + c * sx + d * sy];
     let mut p = start;
     let mut converged = false;
     for _ in 0..config.max_iterations {
-        sample_window(right_plane, p[0], p[1], half, warped)?;
+        sample(p[0], p[1], warped)?;
         let (mean, norm) = mean_and_norm(warped, p0);
         if norm <= 0.0 {
             return None;
@@ -251,11 +327,11 @@ fn refine_in(
             *oy = y * e;
         }
         let [bx, by] = lane_sums([&*p0, &*p1]);
-        // Inverse compositional: Δ = H⁻¹ Σ ∇T·e, p ← p - Δ.
+        // Inverse compositional: Δ = H⁻¹ Σ ∇T·e in the template's offsets, p ← p - warp·Δ.
         let dx = (hyy * bx - hxy * by) / det;
         let dy = (hxx * by - hxy * bx) / det;
-        p[0] -= dx;
-        p[1] -= dy;
+        p[0] -= a * dx + b * dy;
+        p[1] -= c * dx + d * dy;
         if (p[0] - start[0]).abs() > config.max_shift_px
             || (p[1] - start[1]).abs() > config.max_shift_px
         {
@@ -270,7 +346,7 @@ fn refine_in(
         return None;
     }
     // Quality at the solution: correlation and the vertical position uncertainty.
-    sample_window(right_plane, p[0], p[1], half, warped)?;
+    sample(p[0], p[1], warped)?;
     let (mean, norm) = mean_and_norm(warped, p0);
     if norm <= 0.0 {
         return None;
@@ -287,7 +363,9 @@ fn refine_in(
     let [dot, sse] = lane_sums([&*p0, &*p1]);
     let ncc = dot / (t_norm * t_norm);
     let noise_var = sse / (n as f32 - 4.0);
-    let sigma_v = (noise_var * hxx / det).sqrt();
+    // The right point's vertical variance: row (c, d) of the warp through the template's
+    // covariance noise_var · H⁻¹, H⁻¹ = [[hyy, -hxy], [-hxy, hxx]] / det.
+    let sigma_v = (noise_var * (c * c * hyy - 2.0 * c * d * hxy + d * d * hxx) / det).sqrt();
     if ncc < config.min_correlation || sigma_v > config.max_sigma_v_px {
         return None;
     }
@@ -421,6 +499,7 @@ pub fn guided_pair(
     left: [f32; 2],
     guess: [f32; 2],
     search_px: i32,
+    warp: &Warp,
     config: &SubpixelConfig,
 ) -> Option<RefinedPair> {
     let half = i32::try_from(config.half_window).ok()?;
@@ -450,6 +529,7 @@ pub fn guided_pair(
         right_plane,
         [lx as f32, ly as f32],
         [(gx + best_dx) as f32, gy as f32],
+        warp,
         config,
     )
 }
@@ -503,6 +583,7 @@ mod tests {
                 &r,
                 [x, y],
                 [x - 3.0, y + 0.5],
+                &IDENTITY,
                 &SubpixelConfig::default(),
             )
             .unwrap();
@@ -525,6 +606,7 @@ mod tests {
             [50.0, 30.0],
             [47.0, 30.0],
             8,
+            &IDENTITY,
             &SubpixelConfig::default(),
         )
         .unwrap();
@@ -624,13 +706,13 @@ mod tests {
         let l = plane(120, 90, 0.0, 0.0, 1.0);
         let r = plane(120, 90, -3.37, 0.21, 0.9);
         let default = SubpixelConfig::default();
-        let first = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &default).unwrap();
+        let first = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &IDENTITY, &default).unwrap();
         // A larger window grows this thread's scratch arrays and leaves its values in them.
         let config = SubpixelConfig {
             half_window: 12,
             ..default
         };
-        let got = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &config).unwrap();
+        let got = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &IDENTITY, &config).unwrap();
         assert!(
             (got.right[0] - (got.left[0] - 3.37)).abs() < 0.05,
             "{got:?}"
@@ -639,7 +721,7 @@ mod tests {
             (got.right[1] - (got.left[1] + 0.21)).abs() < 0.05,
             "{got:?}"
         );
-        let again = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &default).unwrap();
+        let again = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &IDENTITY, &default).unwrap();
         assert_eq!(format!("{first:?}"), format!("{again:?}"));
         // Windows that cannot fit the plane, however large the configured value, are rejected.
         for half_window in [60, usize::MAX] {
@@ -647,8 +729,10 @@ mod tests {
                 half_window,
                 ..default
             };
-            assert!(refine_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], &config).is_none());
-            assert!(guided_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], 4, &config).is_none());
+            assert!(refine_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], &IDENTITY, &config).is_none());
+            assert!(
+                guided_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], 4, &IDENTITY, &config).is_none()
+            );
         }
     }
 
@@ -660,12 +744,19 @@ mod tests {
             &flat,
             [20.0, 20.0],
             [20.0, 20.0],
+            &IDENTITY,
             &SubpixelConfig::default()
         )
         .is_none());
         let l = plane(40, 40, 0.0, 0.0, 1.0);
-        assert!(
-            refine_pair(&l, &l, [3.0, 20.0], [3.0, 20.0], &SubpixelConfig::default()).is_none()
-        );
+        assert!(refine_pair(
+            &l,
+            &l,
+            [3.0, 20.0],
+            [3.0, 20.0],
+            &IDENTITY,
+            &SubpixelConfig::default()
+        )
+        .is_none());
     }
 }
