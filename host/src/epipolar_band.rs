@@ -153,17 +153,17 @@ struct Pose {
 }
 
 /// The poses whose bands make up the range's: every combination of the ends and the middle of
-/// the verge range, of five left yaws across their range and of the ends and the middle of the
-/// pitch and roll allowances (about the calibration's), the right yaw within its range. The
-/// rows each pose allows move smoothly and almost monotonically with every angle, so the
-/// extremes of the range lie on these poses; the localisation allowance covers what lies
-/// between.
+/// the verge range and of the left yaw's, and of the ends of the pitch and roll allowances
+/// (about the calibration's), the right yaw within its range. The rows move monotonically
+/// with the pitch and the roll (a pitch shifts them, a roll turns them about the principal
+/// point) and smoothly, almost monotonically with the yaws, so the extremes of the range lie
+/// on these poses; the localisation allowance covers what lies between.
 fn poses(calib: &Calibration, range: &PoseRange) -> Vec<Pose> {
     let e = &calib.extrinsics;
     let [v_lo, v_hi] = range.verge_deg;
     let verges = [v_lo, 0.5 * (v_lo + v_hi), v_hi];
     let [l_lo, l_hi] = range.left_yaw_deg;
-    let left_yaws = [0.0, 0.25, 0.5, 0.75, 1.0].map(|t| l_lo + t * (l_hi - l_lo));
+    let left_yaws = [l_lo, 0.5 * (l_lo + l_hi), l_hi];
     let [r_lo, r_hi] = range.right_yaw_deg;
     let m = range.misalignment_deg;
     let mut out = Vec::new();
@@ -171,8 +171,8 @@ fn poses(calib: &Calibration, range: &PoseRange) -> Vec<Pose> {
         for &alpha_l in &left_yaws {
             // The nearest right yaw to this verge's that the range allows.
             let alpha_r = (alpha_l - verge).clamp(r_lo, r_hi);
-            for dp in [-m, 0.0, m] {
-                for dr in [-m, 0.0, m] {
+            for dp in [-m, m] {
+                for dr in [-m, m] {
                     let (p, r) = (
                         (e.pitch_deg + dp).to_radians(),
                         (e.roll_deg + dr).to_radians(),

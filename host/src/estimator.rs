@@ -176,14 +176,20 @@ pub struct VergeEstimator {
     /// The epipolar band over the head's whole range for the image size first seen: a head's
     /// frames keep their size.
     band: OnceLock<((u32, u32), Arc<EpipolarBand>)>,
-    /// The band [`VergeEstimator::estimate_near`] last used, with its image size and rounded
-    /// yaws: a head that holds its verge reuses it frame after frame.
-    near_band: Arc<Mutex<Option<(NearKey, Arc<EpipolarBand>)>>>,
+    /// The bands [`VergeEstimator::estimate_near`] used last, most recent first, with their
+    /// image size and rounded yaws: a head that holds its verge reuses them frame after frame.
+    near_band: Arc<Mutex<Vec<(NearKey, Arc<EpipolarBand>)>>>,
 }
 
 /// What a band near the last estimate is built for: image size and yaws in [`YAW_QUANTUM_DEG`]
 /// steps.
 type NearKey = (u32, u32, i64, i64);
+
+/// Bands near recent estimates kept for reuse: a still head's verge is well determined, but
+/// how it splits between the two yaws wanders by a degree or two from frame to frame (the
+/// split only shows in the near points' parallax), so its rounded yaws cycle through a few
+/// values.
+const NEAR_BANDS: usize = 8;
 
 /// The step the yaws are rounded to before a band is built around them: a head that holds
 /// still keeps its rounded yaws, so its band is built once, and the band's reach grows by one
@@ -238,8 +244,10 @@ impl VergeEstimator {
         let key = (width, height, step(yaws.alpha_l), step(yaws.alpha_r));
         // A poisoned lock only means another thread panicked while building: build anew.
         let mut cache = self.near_band.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, band)) = cache.as_ref().filter(|(k, _)| *k == key) {
-            return band.clone();
+        if let Some(at) = cache.iter().position(|(k, _)| *k == key) {
+            let hit = cache.remove(at);
+            cache.insert(0, hit.clone());
+            return hit.1;
         }
         let rounded = |s: i64| (s as f64 * YAW_QUANTUM_DEG).to_radians();
         let range = PoseRange::around(
@@ -248,7 +256,8 @@ impl VergeEstimator {
             allowance,
         );
         let band = Arc::new(EpipolarBand::new(&self.calib, width, height, &range));
-        *cache = Some((key, band.clone()));
+        cache.truncate(NEAR_BANDS - 1);
+        cache.insert(0, (key, band.clone()));
         band
     }
 

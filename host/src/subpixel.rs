@@ -9,9 +9,11 @@
 //! window is not a translated copy of the left one on a verged head: turning a camera by the
 //! verge maps its image by a homography, which stretches and shears a window by several per
 //! cent at 10-20° (the horizontal scale is 1/cos² of the angle off the axis), and a
-//! translation fitted across such a window moves with the texture's asymmetry. So the right
-//! window is sampled through the homography's local linear map (the caller's [`Warp`]) and
-//! only its translation is estimated. Only the geometry of the point pair matters to the estimator, so fixing the left
+//! translation fitted across such a window moves with the texture's asymmetry. So the left
+//! window (the template) is sampled through the inverse of the homography's local linear map
+//! (the caller's [`Warp`]), which makes it the right window's shape, and only the translation
+//! of the right window is estimated; the template is sampled once per match, so the
+//! iterations keep the translated window's fast sampling. Only the geometry of the point pair matters to the estimator, so fixing the left
 //! point at an integer pixel loses nothing and keeps the interpolation on one side.
 //!
 //! Matches whose window has too little vertical structure (the vertical position would be
@@ -57,9 +59,9 @@ pub type Warp = [f32; 4];
 pub const IDENTITY: Warp = [1.0, 0.0, 0.0, 1.0];
 
 /// A warp whose largest displacement of a window sample, against the identity's, stays below
-/// this (pixels) is sampled as the identity: a few hundredths of a pixel at the window's edge
-/// are below what the refinement resolves (the u8 magnitudes limit it to about that), and the
-/// translated window's shared interpolation weights make it several times faster.
+/// this (pixels) is taken as the identity: the template is then read from whole pixels, with
+/// no interpolation, and a hundredth of a pixel at the window's edge is below what the
+/// refinement resolves (the u8 magnitudes limit it to a few hundredths).
 const WARP_NEGLIGIBLE_PX: f32 = 0.01;
 
 /// A refined point pair in octave-0 (full-resolution) pixels.
@@ -175,7 +177,7 @@ pub fn refine_pair(
     }
     // Inside the plane, so the window side is small enough for any arithmetic below.
     let side = (2 * half + 1) as usize;
-    let len = SCRATCH_ARRAYS * side * side;
+    let len = SCRATCH_ARRAYS * side * side + (side + 2) * (side + 2);
     let mut scratch = SCRATCH.take();
     if scratch.len() < len {
         scratch.resize(len, 0.0);
@@ -197,7 +199,7 @@ pub fn refine_pair(
     refined
 }
 
-/// Window-sized arrays [`refine_in`] works in.
+/// Window-sized arrays [`refine_in`] works in (besides the warped template with its border).
 const SCRATCH_ARRAYS: usize = 7;
 
 /// The sum of each of `arrays`, taken in eight interleaved partial sums that are added
@@ -241,7 +243,7 @@ fn mean_and_norm(window: &[f32], squares: &mut [f32]) -> (f32, f32) {
 
 /// [`refine_pair`] with the left point snapped to `[lx, ly]`, whose window plus a one-pixel
 /// border lies inside the plane, `warp` `None` for the identity, and `buffer`
-/// [`SCRATCH_ARRAYS`] window sizes long.
+/// [`SCRATCH_ARRAYS`] window sizes and one bordered window long.
 #[allow(clippy::too_many_arguments)]
 fn refine_in(
     left_plane: &SobelPlane,
@@ -253,43 +255,76 @@ fn refine_in(
     config: &SubpixelConfig,
     buffer: &mut [f32],
 ) -> Option<RefinedPair> {
-    let sample = |x: f32, y: f32, out: &mut [f32]| match warp {
-        Some(w) => sample_warped(right_plane, x, y, config.half_window as i32, w, out),
-        None => sample_translated(right_plane, x, y, config.half_window as i32, out),
-    };
-    let [a, b, c, d] = *warp.unwrap_or(&IDENTITY);
     let half = config.half_window as i32;
     let side = (2 * half + 1) as usize;
     let n = side * side;
+    let (windows, bordered) = buffer.split_at_mut(SCRATCH_ARRAYS * n);
     // Template, its two gradients, the warped right window and three arrays of terms.
-    let mut arrays = buffer.chunks_exact_mut(n);
+    let mut arrays = windows.chunks_exact_mut(n);
     let [t, gx, gy, warped, p0, p1, p2] =
         std::array::from_fn(|_| arrays.next().unwrap_or_default());
-    // Template, its gradient (central differences) and zero-mean form. Row slices (the row
-    // with its left and right neighbours, the rows above and below) let the loop run
-    // without bounds checks.
-    let (m, stride) = (left_plane.magnitude(), left_plane.width() as usize);
-    let (x0, y0) = ((lx - half) as usize, (ly - half) as usize);
-    for (r, ((t_row, gx_row), gy_row)) in t
+    // Template, its gradient (central differences) and zero-mean form, read from the left
+    // plane's pixels or, through a warp, from its bordered window sampled through the
+    // warp's inverse (in the right image's frame). Row slices (the row with its left and
+    // right neighbours, the rows above and below) let the loop run without bounds checks.
+    let cells = t
         .chunks_exact_mut(side)
         .zip(gx.chunks_exact_mut(side))
-        .zip(gy.chunks_exact_mut(side))
-        .enumerate()
-    {
-        let row = &m[(y0 + r) * stride + x0 - 1..][..side + 2];
-        let above = &m[(y0 + r - 1) * stride + x0..][..side];
-        let below = &m[(y0 + r + 1) * stride + x0..][..side];
-        let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
-        let cells = t_row
-            .iter_mut()
-            .zip(gx_row.iter_mut())
-            .zip(gy_row.iter_mut());
-        for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
-            cells.zip(horizontal).zip(above.iter().zip(below))
-        {
-            *tv = f32::from(c);
-            *gxv = 0.5 * (f32::from(r) - f32::from(l));
-            *gyv = 0.5 * (f32::from(b) - f32::from(a));
+        .zip(gy.chunks_exact_mut(side));
+    match warp {
+        None => {
+            let (m, stride) = (left_plane.magnitude(), left_plane.width() as usize);
+            let (x0, y0) = ((lx - half) as usize, (ly - half) as usize);
+            for (r, ((t_row, gx_row), gy_row)) in cells.enumerate() {
+                let row = &m[(y0 + r) * stride + x0 - 1..][..side + 2];
+                let above = &m[(y0 + r - 1) * stride + x0..][..side];
+                let below = &m[(y0 + r + 1) * stride + x0..][..side];
+                let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
+                let cells = t_row
+                    .iter_mut()
+                    .zip(gx_row.iter_mut())
+                    .zip(gy_row.iter_mut());
+                for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
+                    cells.zip(horizontal).zip(above.iter().zip(below))
+                {
+                    *tv = f32::from(c);
+                    *gxv = 0.5 * (f32::from(r) - f32::from(l));
+                    *gyv = 0.5 * (f32::from(b) - f32::from(a));
+                }
+            }
+        }
+        Some(&[a, b, c, d]) => {
+            let det = a * d - b * c;
+            if !(det.is_finite() && det.abs() > f32::EPSILON) {
+                return None;
+            }
+            let inverse = [d / det, -b / det, -c / det, a / det];
+            sample_warped(
+                left_plane,
+                lx as f32,
+                ly as f32,
+                half + 1,
+                &inverse,
+                bordered,
+            )?;
+            let stride = side + 2;
+            for (r, ((t_row, gx_row), gy_row)) in cells.enumerate() {
+                let row = &bordered[(r + 1) * stride..][..stride];
+                let above = &bordered[r * stride + 1..][..side];
+                let below = &bordered[(r + 2) * stride + 1..][..side];
+                let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
+                let cells = t_row
+                    .iter_mut()
+                    .zip(gx_row.iter_mut())
+                    .zip(gy_row.iter_mut());
+                for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
+                    cells.zip(horizontal).zip(above.iter().zip(below))
+                {
+                    *tv = c;
+                    *gxv = 0.5 * (r - l);
+                    *gyv = 0.5 * (b - a);
+                }
+            }
         }
     }
     let (t_mean, t_norm) = mean_and_norm(t, p0);
@@ -309,12 +344,13 @@ fn refine_in(
         return None;
     }
     // Start: the right point shifted by what the left one was snapped, mapped by the warp.
+    let [a, b, c, d] = *warp.unwrap_or(&IDENTITY);
     let (sx, sy) = (lx as f32 - left[0], ly as f32 - left[1]);
     let start = [right[0] + a * sx + b * sy, right[1] + c * sx + d * sy];
     let mut p = start;
     let mut converged = false;
     for _ in 0..config.max_iterations {
-        sample(p[0], p[1], warped)?;
+        sample_translated(right_plane, p[0], p[1], half, warped)?;
         let (mean, norm) = mean_and_norm(warped, p0);
         if norm <= 0.0 {
             return None;
@@ -327,11 +363,11 @@ fn refine_in(
             *oy = y * e;
         }
         let [bx, by] = lane_sums([&*p0, &*p1]);
-        // Inverse compositional: Δ = H⁻¹ Σ ∇T·e in the template's offsets, p ← p - warp·Δ.
+        // Inverse compositional: Δ = H⁻¹ Σ ∇T·e, p ← p - Δ.
         let dx = (hyy * bx - hxy * by) / det;
         let dy = (hxx * by - hxy * bx) / det;
-        p[0] -= a * dx + b * dy;
-        p[1] -= c * dx + d * dy;
+        p[0] -= dx;
+        p[1] -= dy;
         if (p[0] - start[0]).abs() > config.max_shift_px
             || (p[1] - start[1]).abs() > config.max_shift_px
         {
@@ -346,7 +382,7 @@ fn refine_in(
         return None;
     }
     // Quality at the solution: correlation and the vertical position uncertainty.
-    sample(p[0], p[1], warped)?;
+    sample_translated(right_plane, p[0], p[1], half, warped)?;
     let (mean, norm) = mean_and_norm(warped, p0);
     if norm <= 0.0 {
         return None;
@@ -363,9 +399,7 @@ fn refine_in(
     let [dot, sse] = lane_sums([&*p0, &*p1]);
     let ncc = dot / (t_norm * t_norm);
     let noise_var = sse / (n as f32 - 4.0);
-    // The right point's vertical variance: row (c, d) of the warp through the template's
-    // covariance noise_var · H⁻¹, H⁻¹ = [[hyy, -hxy], [-hxy, hxx]] / det.
-    let sigma_v = (noise_var * (c * c * hyy - 2.0 * c * d * hxy + d * d * hxx) / det).sqrt();
+    let sigma_v = (noise_var * hxx / det).sqrt();
     if ncc < config.min_correlation || sigma_v > config.max_sigma_v_px {
         return None;
     }

@@ -28,6 +28,19 @@ pub struct SceneArgs {
     /// Head motion (default: the scene's own: fixed on the road, manual moves elsewhere).
     #[arg(long)]
     trajectory: Option<TrajectoryKind>,
+    /// The verge the `fixed` trajectory holds, degrees (toe-in positive).
+    #[arg(long, default_value_t = stereocal_synth::FIXED_VERGE_DEG, allow_negative_numbers = true)]
+    verge: f64,
+    /// The left camera's focal length in pixels (default: a 56° horizontal field of view).
+    #[arg(long)]
+    focal: Option<f64>,
+    /// Distance between the optical centres, metres.
+    #[arg(long, default_value_t = stereocal_synth::BASELINE_M)]
+    baseline: f64,
+    /// The right camera's fixed pitch, degrees, not written into calib.toml (a misalignment
+    /// for `--model general` to find).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pitch: f64,
 }
 
 impl SceneArgs {
@@ -38,6 +51,10 @@ impl SceneArgs {
         if let Some(t) = self.trajectory {
             config.trajectory = t;
         }
+        config.fixed_verge_deg = self.verge;
+        config.focal_px = self.focal;
+        config.baseline_m = self.baseline;
+        config.right_pitch_deg = self.pitch;
         Sequence::builtin(self.scene, config)
             .with_context(|| format!("cannot build the `{}` sequence", self.scene))
     }
@@ -109,6 +126,10 @@ pub fn demo(args: &DemoArgs) -> anyhow::Result<()> {
         frames: args.frames,
         seed: args.seed,
         trajectory: Some(TrajectoryKind::Manual),
+        verge: stereocal_synth::FIXED_VERGE_DEG,
+        focal: None,
+        baseline: stereocal_synth::BASELINE_M,
+        pitch: 0.0,
     };
     let sequence = scene.sequence()?;
     let title = format!(

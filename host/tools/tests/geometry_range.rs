@@ -47,7 +47,10 @@ fn check(name: &str, records: &[FrameRecord], bound_deg: f64) {
     let (estimated, max) = figures(records);
     eprintln!("{name}: estimated {estimated:.3}, max |error| {max:.4}°");
     assert!(estimated >= MIN_ESTIMATED, "{name}: estimated {estimated}");
-    assert!(max <= bound_deg, "{name}: max |error| {max}° > {bound_deg}°");
+    assert!(
+        max <= bound_deg,
+        "{name}: max |error| {max}° > {bound_deg}°"
+    );
 }
 
 /// A short focal length: 400 px over 640 px (a 77° field of view). A pixel spans 1.5 times
@@ -59,7 +62,11 @@ fn focal_length_400_px() {
         ..fixed(1.6, 12, 3)
     };
     let bound = ROAD_RAW_MAX_DEG * 600.0 / 400.0;
-    check("f = 400 px", &records(config, SessionConfig::default()), bound);
+    check(
+        "f = 400 px",
+        &records(config, SessionConfig::default()),
+        bound,
+    );
 }
 
 /// A long focal length: 1400 px over 1280 x 960 px (49°), where a fixed gate in pixels would
