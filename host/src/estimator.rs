@@ -178,8 +178,11 @@ pub struct VergeEstimator {
     band: OnceLock<((u32, u32), Arc<EpipolarBand>)>,
     /// The bands [`VergeEstimator::estimate_near`] used last, most recent first, with their
     /// image size and rounded yaws: a head that holds its verge reuses them frame after frame.
-    near_band: Arc<Mutex<Vec<(NearKey, Arc<EpipolarBand>)>>>,
+    near_band: Arc<Mutex<NearBands>>,
 }
+
+/// Bands near recent estimates, most recent first, by what they were built for.
+type NearBands = Vec<(NearKey, Arc<EpipolarBand>)>;
 
 /// What a band near the last estimate is built for: image size and yaws in [`YAW_QUANTUM_DEG`]
 /// steps.
