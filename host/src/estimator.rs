@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use stereocal_hdl::regs::MAX_OCTAVES;
 
 use crate::calib::Calibration;
-use crate::descriptor::{describe, DescriptorConfig};
+use crate::descriptor::{describe, DescriptorConfig, DescriptorSet};
 use crate::epipolar_band::{EpipolarBand, PoseRange};
 use crate::essential::constrained::{self, VergeAngles};
 use crate::essential::general::{self, RelativePose, YawPitchRoll};
@@ -145,8 +145,8 @@ pub struct FrameEstimate {
     pub angles: Option<VergeAngles>,
     /// General model: `R_01` angles. Constrained model: `None`.
     pub pose: Option<YawPitchRoll>,
-    /// The two yaws (the general model's: its verge split as its baseline direction says),
-    /// where the next frame's matching band is centred (see [`VergeEstimator::estimate_near`]).
+    /// The two yaws (the general model's: its verge split as its baseline direction says);
+    /// [`VergeEstimator::estimate`]'s first fit centres its second pass on them.
     pub yaws: VergeAngles,
     /// Descriptor matches found.
     pub matches: usize,
@@ -176,8 +176,8 @@ pub struct VergeEstimator {
     /// The epipolar band over the head's whole range for the image size first seen: a head's
     /// frames keep their size.
     band: OnceLock<((u32, u32), Arc<EpipolarBand>)>,
-    /// The bands [`VergeEstimator::estimate_near`] used last, most recent first, with their
-    /// image size and rounded yaws: a head that holds its verge reuses them frame after frame.
+    /// The bands near the first fit's yaws used last, most recent first, with their image size
+    /// and rounded yaws: a head that holds its verge reuses them frame after frame.
     near_band: Arc<Mutex<NearBands>>,
 }
 
@@ -194,16 +194,15 @@ type NearKey = (u32, u32, i64, i64);
 /// values.
 const NEAR_BANDS: usize = 8;
 
-/// The step the yaws are rounded to before a band is built around them: a head that holds
+/// The step the yaws are rounded to before a pair is matched near them: a head that holds
 /// still keeps its rounded yaws, so its band is built once, and the band's reach grows by one
 /// step to cover the rounding (half a step per yaw, a whole one for the verge).
 const YAW_QUANTUM_DEG: f64 = 0.5;
 
-/// How far the head may turn between two frames for [`VergeEstimator::estimate_near`]'s band
-/// (degrees, each yaw and the verge): a verge motor's fast turn (150 °/s, a CeDAR-class head)
-/// covers 5° between frames at 30 fps. A faster move loses the image corners' matches for a
-/// frame (the centre's rows barely depend on the verge), or the frame falls back to the whole
-/// range.
+/// How far from the first fit's yaws the second pass's band reaches (degrees, each yaw and the
+/// verge; see [`VergeEstimator::estimate`]): the keypoints' fit splits the verge between the
+/// yaws only to within a degree or two on a real drive (the split shows only in the near
+/// points' parallax), and a false split must not cut true matches.
 pub const REACH_DEG: f64 = 5.0;
 
 /// How far, in full-resolution pixels, a keypoint's row may be from its true one on each side:
@@ -281,39 +280,47 @@ impl VergeEstimator {
         k(&self.calib.right) * right.transpose() * rot_y(yaws.alpha_l) * k_left_inv
     }
 
-    /// Matches two frames and returns the matched full-resolution point pairs, refined to
-    /// sub-pixel precision when configured and possible, each with its vertical 1-σ in pixels
-    /// when refined.
+    /// The descriptor matches of two frames, in the band of the poses near `near` (the whole
+    /// range's when `None`).
+    fn matches(
+        &self,
+        left: &FeatureFrame,
+        right: &FeatureFrame,
+        (dl, dr): (&DescriptorSet, &DescriptorSet),
+        near: Option<VergeAngles>,
+    ) -> Vec<Match> {
+        let config = &self.config.matching;
+        let (lk, rk) = (left.keypoints(), right.keypoints());
+        match config.gate {
+            Gate::Epipolar => {
+                let band = self.band(left.width, left.height, near);
+                let rows = |k: &Keypoint| band.rows(k.x, k.y, localisation_px(k));
+                match_descriptors(dl, lk, dr, rk, config, &rows)
+            }
+            Gate::Rows(px) => {
+                let rows = |k: &Keypoint| [k.y - px, k.y + px];
+                match_descriptors(dl, lk, dr, rk, config, &rows)
+            }
+            Gate::Off => {
+                let rows = |_: &Keypoint| [f32::NEG_INFINITY, f32::INFINITY];
+                match_descriptors(dl, lk, dr, rk, config, &rows)
+            }
+        }
+    }
+
+    /// The matched full-resolution point pairs, refined to sub-pixel precision through the
+    /// warp of the yaws `near` (the calibration's when `None`) when configured and possible,
+    /// each with its vertical 1-σ in pixels when refined.
     fn point_pairs(
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
+        matches: &[Match],
         near: Option<VergeAngles>,
-    ) -> (Vec<Match>, Vec<(PixelPair, Option<f32>)>) {
-        // The two images and the matches are independent: both cores work on them.
-        let (dl, dr) = rayon::join(
-            || describe(left, &self.config.descriptor),
-            || describe(right, &self.config.descriptor),
-        );
-        let config = &self.config.matching;
-        let matches = match config.gate {
-            Gate::Epipolar => {
-                let band = self.band(left.width, left.height, near);
-                let rows = |k: &Keypoint| band.rows(k.x, k.y, localisation_px(k));
-                match_descriptors(&dl, left.keypoints(), &dr, right.keypoints(), config, &rows)
-            }
-            Gate::Rows(px) => {
-                let rows = |k: &Keypoint| [k.y - px, k.y + px];
-                match_descriptors(&dl, left.keypoints(), &dr, right.keypoints(), config, &rows)
-            }
-            Gate::Off => {
-                let rows = |_: &Keypoint| [f32::NEG_INFINITY, f32::INFINITY];
-                match_descriptors(&dl, left.keypoints(), &dr, right.keypoints(), config, &rows)
-            }
-        };
+    ) -> Vec<(PixelPair, Option<f32>)> {
         let planes = left.plane(0).zip(right.plane(0));
         let homography = self.rotation_homography(near);
-        let pairs = matches
+        matches
             .par_iter()
             .filter_map(|m| {
                 let kl = left.keypoints()[m.left as usize];
@@ -329,51 +336,84 @@ impl VergeEstimator {
                     )),
                 }
             })
-            .collect();
-        (matches, pairs)
+            .collect()
     }
 
-    /// Estimates the verge angle of one frame pair, matching over the head's whole range of
-    /// poses, then again near the yaws that gives.
+    /// Estimates the verge angle of one frame pair, from that pair alone.
+    ///
+    /// First the head's yaws: a fit to the descriptor matches in the band of the head's whole
+    /// range, at their keypoints' positions. It fixes the verge to a few hundredths of a
+    /// degree and its split between the yaws to a degree or two, which is all the second pass
+    /// needs: only the matches in the band of the poses within [`REACH_DEG`] of those yaws
+    /// (near the image corners much narrower than the whole range's, so it drops the false
+    /// matches the wider band let in), refined through sub-pixel windows warped by them. When
+    /// that gives no estimate, or the first fit failed, the whole range's matches are refined
+    /// as they are.
     pub fn estimate(
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> Result<FrameEstimate, EstimateError> {
-        let first = self.estimate_within(left, right, None)?;
-        // Without yaws to start from the windows were warped for the calibrated head; with the
-        // yaws found, the pair is matched and refined again in their band and through their
-        // warp.
-        Ok(self
-            .estimate_within(left, right, Some(first.yaws))
-            .unwrap_or(first))
+        // The two images are independent: both cores describe them.
+        let (dl, dr) = rayon::join(
+            || describe(left, &self.config.descriptor),
+            || describe(right, &self.config.descriptor),
+        );
+        let descriptors = (&dl, &dr);
+        let whole = self.matches(left, right, descriptors, None);
+        let keypoint_pairs: Vec<PixelPair> = whole
+            .iter()
+            .map(|m| {
+                let (kl, kr) = (
+                    left.keypoints()[m.left as usize],
+                    right.keypoints()[m.right as usize],
+                );
+                ([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64])
+            })
+            .collect();
+        let yaws = self
+            .estimate_weighted(&keypoint_pairs, &vec![1.0; keypoint_pairs.len()])
+            .ok()
+            .map(|e| rounded(e.yaws));
+        if let Some(yaws) = yaws {
+            let near = match self.config.matching.gate {
+                // The near band lies inside the whole range's, so its matches are the whole
+                // range's whose right keypoint lies in it; the ratio test already held against
+                // the wider band's candidates.
+                Gate::Epipolar => {
+                    let band = self.band(left.width, left.height, Some(yaws));
+                    whole
+                        .iter()
+                        .filter(|m| {
+                            let (kl, kr) = (
+                                &left.keypoints()[m.left as usize],
+                                &right.keypoints()[m.right as usize],
+                            );
+                            let [lo, hi] = band.rows(kl.x, kl.y, localisation_px(kl));
+                            (lo..=hi).contains(&kr.y)
+                        })
+                        .copied()
+                        .collect()
+                }
+                Gate::Rows(_) | Gate::Off => whole.clone(),
+            };
+            if let Ok(est) = self.estimate_from(left, right, near, Some(yaws)) {
+                return Ok(est);
+            }
+        }
+        self.estimate_from(left, right, whole, None)
     }
 
-    /// Estimates the verge angle of one frame pair whose head is expected near `yaws` (the
-    /// last estimate's): matching looks only in the band of the poses within
-    /// [`REACH_DEG`] of them, which near the image corners is much narrower than the whole
-    /// range's, so fewer false candidates compete with the true one. When that gives no
-    /// estimate (the head moved further) the whole range is tried.
-    pub fn estimate_near(
+    /// The estimate from `matches`, refined through the warp of `near` (see
+    /// [`VergeEstimator::point_pairs`]), with the guided matches added.
+    fn estimate_from(
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
-        yaws: Option<VergeAngles>,
-    ) -> Result<FrameEstimate, EstimateError> {
-        let Some(yaws) = yaws else {
-            return self.estimate(left, right);
-        };
-        self.estimate_within(left, right, Some(yaws))
-            .or_else(|_| self.estimate(left, right))
-    }
-
-    fn estimate_within(
-        &self,
-        left: &FeatureFrame,
-        right: &FeatureFrame,
+        matches: Vec<Match>,
         near: Option<VergeAngles>,
     ) -> Result<FrameEstimate, EstimateError> {
-        let (matches, mut pairs) = self.point_pairs(left, right, near);
+        let mut pairs = self.point_pairs(left, right, &matches, near);
         if let (Some(g), Some(sub), Some(pl), Some(pr)) = (
             self.config.guided,
             self.config.subpixel,
@@ -533,6 +573,15 @@ fn lowest_cost<F>(
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, f)| f)
         .ok_or(first_err.unwrap_or(EssentialError::Degenerate))
+}
+
+/// `yaws` rounded to [`YAW_QUANTUM_DEG`].
+fn rounded(yaws: VergeAngles) -> VergeAngles {
+    let round = |a: f64| (a.to_degrees() / YAW_QUANTUM_DEG).round() * YAW_QUANTUM_DEG;
+    VergeAngles::new(
+        round(yaws.alpha_l).to_radians(),
+        round(yaws.alpha_r).to_radians(),
+    )
 }
 
 /// The local linear map (Jacobian) of the homography `h` at the left pixel (`x`, `y`): how a

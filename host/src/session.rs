@@ -15,7 +15,6 @@ use stereocal_hdl::FabricConfig;
 
 use crate::calib::Calibration;
 use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome};
-use crate::essential::constrained::VergeAngles;
 use crate::estimator::{EstimatorConfig, FrameEstimate, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
 use crate::link::{FrameInput, InProcessLink, Link, LinkError, Threaded};
@@ -182,8 +181,6 @@ pub struct Session<L: Link = Threaded> {
     early: Option<PairOutcome>,
     /// Capture time of the last pair filtered.
     last_timestamp_us: Option<u64>,
-    /// The last estimate's yaws: the next pair's matching band is centred on them.
-    last_yaws: Option<VergeAngles>,
     /// The head's verge reading for the next pair submitted ([`Session::encoder_reading`]).
     next_encoder_deg: Option<f64>,
     cost: SessionCost,
@@ -232,7 +229,6 @@ impl<L: Link> Session<L> {
             in_flight: VecDeque::new(),
             early: None,
             last_timestamp_us: None,
-            last_yaws: None,
             next_encoder_deg: None,
             cost: SessionCost::default(),
         })
@@ -385,12 +381,7 @@ impl<L: Link> Session<L> {
             }) => {
                 record.status = FrameStatus::NoEstimate;
                 let estimating = Instant::now();
-                let estimate =
-                    self.estimator
-                        .estimate_near(&left.features, &right.features, self.last_yaws);
-                if let Ok(est) = &estimate {
-                    self.last_yaws = Some(est.yaws);
-                }
+                let estimate = self.estimator.estimate(&left.features, &right.features);
                 let estimate = estimate.map(|est| self.refit_misaligned(est, &mut record));
                 self.cost.estimating += estimating.elapsed();
                 match estimate {
