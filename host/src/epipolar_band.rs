@@ -53,7 +53,7 @@ impl PoseRange {
         }
     }
 
-    /// The poses within `reach_deg` of the yaws `yaws` (the last estimate's, brought into the
+    /// The poses within `reach_deg` of the yaws `yaws` (a first fit's, brought into the
     /// head's whole range), inside that range.
     pub fn around(yaws: VergeAngles, reach_deg: f64, misalignment_deg: f64) -> Self {
         let near = |a: f64| {

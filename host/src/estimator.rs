@@ -184,7 +184,7 @@ pub struct VergeEstimator {
 /// Bands near recent estimates, most recent first, by what they were built for.
 type NearBands = Vec<(NearKey, Arc<EpipolarBand>)>;
 
-/// What a band near the last estimate is built for: image size and yaws in [`YAW_QUANTUM_DEG`]
+/// What a band near a first fit is built for: image size and yaws in [`YAW_QUANTUM_DEG`]
 /// steps.
 type NearKey = (u32, u32, i64, i64);
 
