@@ -103,6 +103,8 @@ fn bench(c: &mut Criterion) {
     };
     let config = EstimatorConfig::default();
     let estimator = VergeEstimator::new(calib, config);
+    // The fixed band the matcher's benchmark has always timed (a rectified pair's rows).
+    let rows = |k: &stereocal::features::Keypoint| [k.y - 24.0, k.y + 24.0];
     let dl = describe(&lf, &DescriptorConfig::default());
     let dr = describe(&rf, &DescriptorConfig::default());
     let matches = match_descriptors(
@@ -111,6 +113,7 @@ fn bench(c: &mut Criterion) {
         &dr,
         rf.keypoints(),
         &MatchConfig::default(),
+        &rows,
     );
     assert!(matches.len() > 300, "{} matches", matches.len());
     let pairs: Vec<([f64; 2], [f64; 2])> = matches
@@ -150,6 +153,7 @@ fn bench(c: &mut Criterion) {
                 black_box(&dr),
                 rf.keypoints(),
                 &config.matching,
+                &rows,
             );
             let p: Vec<([f64; 2], [f64; 2])> = m
                 .iter()
@@ -180,6 +184,7 @@ fn bench(c: &mut Criterion) {
                 black_box(&dr),
                 rf.keypoints(),
                 &config.matching,
+                &rows,
             )
         })
     });
@@ -196,6 +201,7 @@ fn bench(c: &mut Criterion) {
                     pr,
                     [l[0] as f32, l[1] as f32],
                     [r[0] as f32, r[1] as f32],
+                    &stereocal::subpixel::IDENTITY,
                     &SubpixelConfig::default(),
                 )
             })

@@ -7,19 +7,23 @@
 //! starting point and a Cauchy-weighted Gauss-Newton refinement over all matches gives the
 //! answer and its uncertainty.
 
+use std::sync::{Arc, Mutex, OnceLock};
+
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 use stereocal_hdl::regs::MAX_OCTAVES;
 
 use crate::calib::Calibration;
-use crate::descriptor::{describe, DescriptorConfig};
+use crate::descriptor::{describe, DescriptorConfig, DescriptorSet};
+use crate::epipolar_band::{EpipolarBand, PoseRange};
 use crate::essential::constrained::{self, VergeAngles};
 use crate::essential::general::{self, RelativePose, YawPitchRoll};
 use crate::essential::{cauchy_cost, Correspondence, EssentialError, RefineConfig};
+use crate::essential::{rot_x, rot_y, rot_z};
 use crate::features::{FeatureFrame, Keypoint, SobelPlane};
-use crate::matching::{match_descriptors, Match, MatchConfig};
+use crate::matching::{match_descriptors, Gate, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
-use crate::subpixel::{guided_pair, refine_pair, RefinedPair, SubpixelConfig};
+use crate::subpixel::{guided_pair, refine_pair, RefinedPair, SubpixelConfig, Warp};
 
 /// A matched point pair in full-resolution pixels: (left, right).
 pub type PixelPair = ([f64; 2], [f64; 2]);
@@ -32,6 +36,20 @@ pub enum Model {
     Constrained,
     /// Free relative rotation and baseline direction (heads that also tilt).
     General,
+}
+
+impl Model {
+    /// The relative pitch and roll, beyond the calibration's, that the matching gate lets
+    /// through (degrees). The constrained model explains none: a head whose calibration misses
+    /// more than a degree of either is outside what it can fit, so a wider gate would only let
+    /// in false candidates. The general model fits them, for heads assembled within a few
+    /// degrees.
+    pub fn misalignment_allowance_deg(self) -> f64 {
+        match self {
+            Model::Constrained => 1.0,
+            Model::General => 3.0,
+        }
+    }
 }
 
 /// Settings of the whole per-frame estimate.
@@ -55,6 +73,9 @@ pub struct EstimatorConfig {
     pub min_matches: usize,
     /// Guided matching of the keypoints the descriptors left unmatched (needs Sobel planes).
     pub guided: Option<GuidedConfig>,
+    /// Relative pitch and roll beyond the calibration's that the epipolar gate allows
+    /// (degrees); `None`: the model's own (see [`Model::misalignment_allowance_deg`]).
+    pub misalignment_allowance_deg: Option<f64>,
     /// Weigh each refined match by the inverse variance of its vertical position,
     /// `1 / max(σ_v, floor)²`, with this floor in pixels; `None`: every match alike.
     ///
@@ -101,6 +122,7 @@ impl Default for EstimatorConfig {
             model: Model::Constrained,
             min_matches: 12,
             guided: Some(GuidedConfig::default()),
+            misalignment_allowance_deg: None,
             weight_floor_px: Some(0.02),
         }
     }
@@ -135,6 +157,9 @@ pub struct FrameEstimate {
     pub angles: Option<VergeAngles>,
     /// General model: `R_01` angles. Constrained model: `None`.
     pub pose: Option<YawPitchRoll>,
+    /// The two yaws (the general model's: its verge split as its baseline direction says);
+    /// [`VergeEstimator::estimate`]'s first fit centres its second pass on them.
+    pub yaws: VergeAngles,
     /// Descriptor matches found.
     pub matches: usize,
     /// Matches that entered the estimate (after sub-pixel rejection).
@@ -160,12 +185,54 @@ pub struct FrameEstimate {
 pub struct VergeEstimator {
     calib: Calibration,
     config: EstimatorConfig,
+    /// The epipolar band over the head's whole range for the image size first seen: a head's
+    /// frames keep their size.
+    band: OnceLock<((u32, u32), Arc<EpipolarBand>)>,
+    /// The bands near the first fit's yaws used last, most recent first, with their image size
+    /// and rounded yaws: a head that holds its verge reuses them frame after frame.
+    near_band: Arc<Mutex<NearBands>>,
+}
+
+/// Bands near recent estimates, most recent first, by what they were built for.
+type NearBands = Vec<(NearKey, Arc<EpipolarBand>)>;
+
+/// What a band near a first fit is built for: image size and yaws in [`YAW_QUANTUM_DEG`]
+/// steps.
+type NearKey = (u32, u32, i64, i64);
+
+/// Bands near recent estimates kept for reuse: a still head's verge is well determined, but
+/// how it splits between the two yaws wanders by a degree or two from frame to frame (the
+/// split only shows in the near points' parallax), so its rounded yaws cycle through a few
+/// values.
+const NEAR_BANDS: usize = 8;
+
+/// The step the yaws are rounded to before a pair is matched near them: a head that holds
+/// still keeps its rounded yaws, so its band is built once, and the band's reach grows by one
+/// step to cover the rounding (half a step per yaw, a whole one for the verge).
+const YAW_QUANTUM_DEG: f64 = 0.5;
+
+/// How far from the first fit's yaws the second pass's band reaches (degrees, each yaw and the
+/// verge; see [`VergeEstimator::estimate`]): the keypoints' fit splits the verge between the
+/// yaws only to within a degree or two on a real drive (the split shows only in the near
+/// points' parallax), and a false split must not cut true matches.
+pub const REACH_DEG: f64 = 5.0;
+
+/// How far, in full-resolution pixels, a keypoint's row may be from its true one on each side:
+/// the fabric's quadratic fit places an extremum within half a sample of its octave's grid,
+/// and both keypoints of a match carry that error.
+fn localisation_px(k: &Keypoint) -> f32 {
+    f32::from(1u16 << k.octave.min(15))
 }
 
 impl VergeEstimator {
     /// An estimator for the head `calib` describes.
     pub fn new(calib: Calibration, config: EstimatorConfig) -> Self {
-        Self { calib, config }
+        Self {
+            calib,
+            config,
+            band: OnceLock::new(),
+            near_band: Arc::default(),
+        }
     }
 
     /// The settings it was made with.
@@ -173,35 +240,113 @@ impl VergeEstimator {
         &self.config
     }
 
-    /// Matches two frames and returns the matched full-resolution point pairs, refined to
-    /// sub-pixel precision when configured and possible, each with its vertical 1-σ in pixels
-    /// when refined.
+    fn misalignment_allowance_deg(&self) -> f64 {
+        self.config
+            .misalignment_allowance_deg
+            .unwrap_or(self.config.model.misalignment_allowance_deg())
+    }
+
+    /// The epipolar band of `width` x `height` frames over the poses near `near` (see
+    /// [`YAW_QUANTUM_DEG`]), or over the head's whole range when `None`.
+    fn band(&self, width: u32, height: u32, near: Option<VergeAngles>) -> Arc<EpipolarBand> {
+        let allowance = self.misalignment_allowance_deg();
+        let Some(yaws) = near else {
+            let range = PoseRange::verge_head(allowance);
+            let build = || Arc::new(EpipolarBand::new(&self.calib, width, height, &range));
+            let (size, band) = self.band.get_or_init(|| ((width, height), build()));
+            return if *size == (width, height) {
+                band.clone()
+            } else {
+                build()
+            };
+        };
+        let step = |a: f64| (a.to_degrees() / YAW_QUANTUM_DEG).round() as i64;
+        let key = (width, height, step(yaws.alpha_l), step(yaws.alpha_r));
+        // A poisoned lock only means another thread panicked while building: build anew.
+        let mut cache = self.near_band.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(at) = cache.iter().position(|(k, _)| *k == key) {
+            let hit = cache.remove(at);
+            cache.insert(0, hit.clone());
+            return hit.1;
+        }
+        let rounded = |s: i64| (s as f64 * YAW_QUANTUM_DEG).to_radians();
+        let range = PoseRange::around(
+            VergeAngles::new(rounded(key.2), rounded(key.3)),
+            REACH_DEG + YAW_QUANTUM_DEG,
+            allowance,
+        );
+        let band = Arc::new(EpipolarBand::new(&self.calib, width, height, &range));
+        cache.truncate(NEAR_BANDS - 1);
+        cache.insert(0, (key, band.clone()));
+        band
+    }
+
+    /// The map `K_r R K_l⁻¹` of left pixels to right pixels that turning the cameras to
+    /// `near`'s yaws (the calibration's when `None`), with the calibration's pitch and roll,
+    /// makes for distant points: what the sub-pixel refinement warps its windows by.
+    fn rotation_homography(&self, near: Option<VergeAngles>) -> Matrix3<f64> {
+        let e = &self.calib.extrinsics;
+        let yaws = near.unwrap_or_else(|| VergeAngles::from_extrinsics(e));
+        let right =
+            rot_y(yaws.alpha_r) * rot_x(e.pitch_deg.to_radians()) * rot_z(e.roll_deg.to_radians());
+        let k = |c: &crate::calib::CameraIntrinsics| {
+            Matrix3::new(c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0)
+        };
+        let k_left_inv = k(&self.calib.left)
+            .try_inverse()
+            .unwrap_or_else(Matrix3::identity);
+        k(&self.calib.right) * right.transpose() * rot_y(yaws.alpha_l) * k_left_inv
+    }
+
+    /// The descriptor matches of two frames, in the band of the poses near `near` (the whole
+    /// range's when `None`).
+    fn matches(
+        &self,
+        left: &FeatureFrame,
+        right: &FeatureFrame,
+        (dl, dr): (&DescriptorSet, &DescriptorSet),
+        near: Option<VergeAngles>,
+    ) -> Vec<Match> {
+        let config = &self.config.matching;
+        let (lk, rk) = (left.keypoints(), right.keypoints());
+        match config.gate {
+            Gate::Epipolar => {
+                let band = self.band(left.width, left.height, near);
+                let rows = |k: &Keypoint| band.rows(k.x, k.y, localisation_px(k));
+                match_descriptors(dl, lk, dr, rk, config, &rows)
+            }
+            Gate::Rows(px) => {
+                let rows = |k: &Keypoint| [k.y - px, k.y + px];
+                match_descriptors(dl, lk, dr, rk, config, &rows)
+            }
+            Gate::Off => {
+                let rows = |_: &Keypoint| [f32::NEG_INFINITY, f32::INFINITY];
+                match_descriptors(dl, lk, dr, rk, config, &rows)
+            }
+        }
+    }
+
+    /// The matched full-resolution point pairs, refined to sub-pixel precision through the
+    /// warp of the yaws `near` (the calibration's when `None`) when configured and possible,
+    /// each with its vertical 1-σ in pixels when refined.
     fn point_pairs(
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
-    ) -> (Vec<Match>, Vec<(PixelPair, Option<f32>)>) {
-        // The two images and the matches are independent: both cores work on them.
-        let (dl, dr) = rayon::join(
-            || describe(left, &self.config.descriptor),
-            || describe(right, &self.config.descriptor),
-        );
-        let matches = match_descriptors(
-            &dl,
-            left.keypoints(),
-            &dr,
-            right.keypoints(),
-            &self.config.matching,
-        );
+        matches: &[Match],
+        near: Option<VergeAngles>,
+    ) -> Vec<(PixelPair, Option<f32>)> {
         let planes = left.plane(0).zip(right.plane(0));
-        let pairs = matches
+        let homography = self.rotation_homography(near);
+        matches
             .par_iter()
             .filter_map(|m| {
                 let kl = left.keypoints()[m.left as usize];
                 let kr = right.keypoints()[m.right as usize];
                 match (self.config.subpixel, planes) {
                     (Some(cfg), Some((pl, pr))) => {
-                        refine_pair(pl, pr, [kl.x, kl.y], [kr.x, kr.y], &cfg).map(refined)
+                        let warp = local_warp(&homography, kl.x, kl.y);
+                        refine_pair(pl, pr, [kl.x, kl.y], [kr.x, kr.y], &warp, &cfg).map(refined)
                     }
                     _ => Some((
                         ([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64]),
@@ -209,24 +354,92 @@ impl VergeEstimator {
                     )),
                 }
             })
-            .collect();
-        (matches, pairs)
+            .collect()
     }
 
-    /// Estimates the verge angle of one frame pair.
+    /// Estimates the verge angle of one frame pair, from that pair alone.
+    ///
+    /// First the head's yaws: a fit to the descriptor matches in the band of the head's whole
+    /// range, at their keypoints' positions. It fixes the verge to a few hundredths of a
+    /// degree and its split between the yaws to a degree or two, which is all the second pass
+    /// needs: only the matches in the band of the poses within [`REACH_DEG`] of those yaws
+    /// (near the image corners much narrower than the whole range's, so it drops the false
+    /// matches the wider band let in), refined through sub-pixel windows warped by them. When
+    /// that gives no estimate, or the first fit failed, the whole range's matches are refined
+    /// as they are.
     pub fn estimate(
         &self,
         left: &FeatureFrame,
         right: &FeatureFrame,
     ) -> Result<FrameEstimate, EstimateError> {
-        let (matches, mut pairs) = self.point_pairs(left, right);
+        // The two images are independent: both cores describe them.
+        let (dl, dr) = rayon::join(
+            || describe(left, &self.config.descriptor),
+            || describe(right, &self.config.descriptor),
+        );
+        let descriptors = (&dl, &dr);
+        let whole = self.matches(left, right, descriptors, None);
+        let keypoint_pairs: Vec<PixelPair> = whole
+            .iter()
+            .map(|m| {
+                let (kl, kr) = (
+                    left.keypoints()[m.left as usize],
+                    right.keypoints()[m.right as usize],
+                );
+                ([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64])
+            })
+            .collect();
+        let yaws = self
+            .estimate_weighted(&keypoint_pairs, &vec![1.0; keypoint_pairs.len()])
+            .ok()
+            .map(|e| rounded(e.yaws));
+        if let Some(yaws) = yaws {
+            let near = match self.config.matching.gate {
+                // The near band lies inside the whole range's, so its matches are the whole
+                // range's whose right keypoint lies in it; the ratio test already held against
+                // the wider band's candidates.
+                Gate::Epipolar => {
+                    let band = self.band(left.width, left.height, Some(yaws));
+                    whole
+                        .iter()
+                        .filter(|m| {
+                            let (kl, kr) = (
+                                &left.keypoints()[m.left as usize],
+                                &right.keypoints()[m.right as usize],
+                            );
+                            let [lo, hi] = band.rows(kl.x, kl.y, localisation_px(kl));
+                            (lo..=hi).contains(&kr.y)
+                        })
+                        .copied()
+                        .collect()
+                }
+                Gate::Rows(_) | Gate::Off => whole.clone(),
+            };
+            if let Ok(est) = self.estimate_from(left, right, near, Some(yaws)) {
+                return Ok(est);
+            }
+        }
+        self.estimate_from(left, right, whole, None)
+    }
+
+    /// The estimate from `matches`, refined through the warp of `near` (see
+    /// [`VergeEstimator::point_pairs`]), with the guided matches added.
+    fn estimate_from(
+        &self,
+        left: &FeatureFrame,
+        right: &FeatureFrame,
+        matches: Vec<Match>,
+        near: Option<VergeAngles>,
+    ) -> Result<FrameEstimate, EstimateError> {
+        let mut pairs = self.point_pairs(left, right, &matches, near);
         if let (Some(g), Some(sub), Some(pl), Some(pr)) = (
             self.config.guided,
             self.config.subpixel,
             left.plane(0),
             right.plane(0),
         ) {
-            let extra = guided_pairs(left, &matches, &pairs, pl, pr, &g, &sub);
+            let homography = self.rotation_homography(near);
+            let extra = guided_pairs(left, &matches, &pairs, pl, pr, &homography, &g, &sub);
             pairs.extend(extra);
         }
         let weights = match_weights(&pairs, self.config.weight_floor_px);
@@ -309,6 +522,7 @@ impl VergeEstimator {
             sigma_deg: cfit.verge_sigma.to_degrees(),
             angles: Some(cfit.angles),
             pose: None,
+            yaws: cfit.angles,
             matches: pairs.len(),
             used: pairs.len(),
             inliers: cfit.inlier_count(),
@@ -341,6 +555,7 @@ impl VergeEstimator {
             est.angles = None;
             est.consistent = Vec::new();
             est.pose = Some(gfit.pose.yaw_pitch_roll());
+            est.yaws = gfit.pose.yaws();
             est.inliers = gfit.inlier_count();
             est.residual_px = gfit.residual_sigma * focal;
         }
@@ -376,6 +591,26 @@ fn lowest_cost<F>(
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, f)| f)
         .ok_or(first_err.unwrap_or(EssentialError::Degenerate))
+}
+
+/// `yaws` rounded to [`YAW_QUANTUM_DEG`].
+fn rounded(yaws: VergeAngles) -> VergeAngles {
+    let round = |a: f64| (a.to_degrees() / YAW_QUANTUM_DEG).round() * YAW_QUANTUM_DEG;
+    VergeAngles::new(
+        round(yaws.alpha_l).to_radians(),
+        round(yaws.alpha_r).to_radians(),
+    )
+}
+
+/// The local linear map (Jacobian) of the homography `h` at the left pixel (`x`, `y`): how a
+/// window around it appears in the right image.
+fn local_warp(h: &Matrix3<f64>, x: f32, y: f32) -> Warp {
+    let (x, y) = (f64::from(x), f64::from(y));
+    let w = h[(2, 0)] * x + h[(2, 1)] * y + h[(2, 2)];
+    let u = (h[(0, 0)] * x + h[(0, 1)] * y + h[(0, 2)]) / w;
+    let v = (h[(1, 0)] * x + h[(1, 1)] * y + h[(1, 2)]) / w;
+    let j = |r: usize, c: usize, p: f64| ((h[(r, c)] - p * h[(2, c)]) / w) as f32;
+    [j(0, 0, u), j(0, 1, u), j(1, 0, v), j(1, 1, v)]
 }
 
 /// A refined match as the estimator takes it: the pixel pair and its vertical 1-σ.
@@ -419,13 +654,16 @@ fn per_octave(octaves: impl Iterator<Item = u8>) -> Vec<usize> {
     counts
 }
 
-/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]).
+/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]),
+/// refined through `homography`'s local warp.
+#[allow(clippy::too_many_arguments)]
 fn guided_pairs(
     left: &FeatureFrame,
     matches: &[Match],
     pairs: &[(PixelPair, Option<f32>)],
     pl: &SobelPlane,
     pr: &SobelPlane,
+    homography: &Matrix3<f64>,
     g: &GuidedConfig,
     sub: &SubpixelConfig,
 ) -> Vec<(PixelPair, Option<f32>)> {
@@ -479,7 +717,8 @@ fn guided_pairs(
                     kp.x + median(|(l, r)| r[0] - l[0]),
                     kp.y + median(|(l, r)| r[1] - l[1]),
                 ];
-                guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, sub).map(|r| (kp, r))
+                let warp = local_warp(homography, kp.x, kp.y);
+                guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, &warp, sub).map(|r| (kp, r))
             },
         )
         .flatten()

@@ -12,7 +12,7 @@
 //! | byte links to a device | [`link`] |
 //! | the wire's packets reassembled into camera frames | [`driver`] |
 //! | a camera frame's keypoints and gradients | [`features`] |
-//! | descriptors, matching, sub-pixel refinement | [`descriptor`], [`matching`], [`subpixel`] |
+//! | descriptors, matching in the epipolar band, sub-pixel refinement | [`descriptor`], [`epipolar_band`], [`matching`], [`subpixel`] |
 //! | essential matrix constrained to the head, RANSAC | [`essential`], [`ransac`] |
 //! | one pair's verge | [`estimator`] |
 //! | over time: the Kalman filter, the head's fixed misalignments, its encoders | [`kalman`], [`misalignment`], [`encoders`] |
@@ -29,6 +29,7 @@ pub mod calib;
 pub mod descriptor;
 pub mod driver;
 pub mod encoders;
+pub mod epipolar_band;
 pub mod essential;
 pub mod estimator;
 pub mod features;

@@ -1,8 +1,9 @@
 //! Nearest-neighbour matching of left and right descriptors (thesis 4.4.3).
 //!
-//! Candidates are the right keypoints within a vertical band around the left keypoint (on a
-//! verge head the vertical disparity stays a few pixels, so the band removes most false
-//! candidates and most of the work); the best candidate must beat the second best by the
+//! Candidates are the right keypoints within the band of rows where the left keypoint's match
+//! can lie (the caller's [`RowBand`]: on a verge head the epipolar geometry keeps a match within
+//! a few pixels of rows near the image centre and within tens at the corners, so the band
+//! removes most false candidates and most of the work); the best candidate must beat the second best by the
 //! ratio test; optionally the match must also be the left keypoint's best from the right
 //! side (left-right consistency); optionally only the N best are kept.
 //!
@@ -27,9 +28,25 @@ pub struct MatchConfig {
     /// keeps every match that passes: the refinement needs many matches for sub-0.05°
     /// accuracy, and it is robust to the few extra outliers.
     pub best_n: Option<usize>,
-    /// Only right keypoints with |y_r - y_l| ≤ this (full-resolution pixels) are candidates.
-    pub max_vertical_px: Option<f32>,
+    /// Which right keypoints are candidates for a left one, by row.
+    pub gate: Gate,
 }
+
+/// The rows of the right image a left keypoint's candidates come from.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Gate {
+    /// The epipolar band the calibration, the image size and the head's range of poses allow
+    /// (`crate::epipolar_band`).
+    #[default]
+    Epipolar,
+    /// |y_r - y_l| ≤ this many full-resolution pixels, whatever the geometry.
+    Rows(f32),
+    /// Every right keypoint.
+    Off,
+}
+
+/// The right rows `[lowest, highest]` a left keypoint's candidates may have.
+pub type RowBand<'a> = &'a (dyn Fn(&Keypoint) -> [f32; 2] + Sync);
 
 impl Default for MatchConfig {
     fn default() -> Self {
@@ -37,7 +54,7 @@ impl Default for MatchConfig {
             ratio: 0.6,
             cross_check: true,
             best_n: None,
-            max_vertical_px: Some(24.0),
+            gate: Gate::Epipolar,
         }
     }
 }
@@ -104,13 +121,15 @@ impl Scan {
 }
 
 /// Matches the left descriptors against the right ones. Keypoint slices are the frames'
-/// keypoints (the sets index into them). Output sorted by increasing distance.
+/// keypoints (the sets index into them); `band` gives each left keypoint's candidate rows
+/// (`config.gate` is the caller's to turn into it). Output sorted by increasing distance.
 pub fn match_descriptors(
     left: &DescriptorSet,
     left_kp: &[Keypoint],
     right: &DescriptorSet,
     right_kp: &[Keypoint],
     config: &MatchConfig,
+    band: RowBand<'_>,
 ) -> Vec<Match> {
     if left.is_empty() || right.is_empty() || left.dim() != right.dim() {
         return Vec::new();
@@ -129,16 +148,15 @@ pub fn match_descriptors(
     let left_all: Vec<i8> = (0..left.len())
         .flat_map(|i| left.get(i).iter().map(offset))
         .collect();
-    let band = config.max_vertical_px.unwrap_or(f32::INFINITY);
 
     // Each left descriptor's best and second-best candidate, and the best left (distance,
     // index) per right descriptor for the cross check. The left descriptors are independent,
     // so both cores scan them; per right descriptor the nearer left one wins, the lower index
     // on a tie, as in one pass in index order.
     let scan = |mut acc: Scan, i: usize| {
-        let yl = left_kp[left.keypoint(i)].y;
-        let lo = ys.partition_point(|&y| y < yl - band);
-        let hi = ys.partition_point(|&y| y <= yl + band);
+        let [top, bottom] = band(&left_kp[left.keypoint(i)]);
+        let lo = ys.partition_point(|&y| y < top);
+        let hi = ys.partition_point(|&y| y <= bottom).max(lo);
         let d = &left_all[i * dim..(i + 1) * dim];
         let (mut b1, mut b2, mut j1) = (u32::MAX, u32::MAX, u32::MAX);
         for (s, &j) in order[lo..hi].iter().enumerate() {
@@ -220,6 +238,11 @@ mod tests {
         (x.wrapping_mul(73856093) ^ y.wrapping_mul(19349663)) as u32
     }
 
+    /// The band of rows within `px` of the left keypoint's.
+    fn rows(px: f32) -> impl Fn(&Keypoint) -> [f32; 2] + Sync {
+        move |k: &Keypoint| [k.y - px, k.y + px]
+    }
+
     fn textured(width: u32, height: u32, dx: i32, dy: i32) -> SobelPlane {
         hashed(width, height, |x, y| texture_hash(x - dx, y - dy))
     }
@@ -256,6 +279,7 @@ mod tests {
             &dr,
             r.keypoints(),
             &MatchConfig::default(),
+            &rows(24.0),
         );
         assert_eq!(m.len(), 40);
         assert!(m
@@ -266,15 +290,22 @@ mod tests {
             ..MatchConfig::default()
         };
         assert_eq!(
-            match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &few).len(),
+            match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &few, &rows(24.0)).len(),
             20
         );
-        // A 0-pixel band excludes the right points (they are 1 px lower).
-        let tight = MatchConfig {
-            max_vertical_px: Some(0.5),
-            ..MatchConfig::default()
-        };
-        assert!(match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &tight).is_empty());
+        // A half-pixel band excludes the right points (they are 1 px lower), and so does a band
+        // a pixel off in the other direction.
+        let cfg = MatchConfig::default();
+        assert!(
+            match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &cfg, &rows(0.5)).is_empty()
+        );
+        let above = |k: &Keypoint| [k.y - 1.5, k.y - 0.5];
+        assert!(match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &cfg, &above).is_empty());
+        let below = |k: &Keypoint| [k.y + 0.5, k.y + 1.5];
+        assert_eq!(
+            match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &cfg, &below).len(),
+            40
+        );
     }
 
     /// A texture that repeats every 8 pixels: keypoints 8 pixels apart get equal descriptors,
@@ -304,7 +335,7 @@ mod tests {
                     .build()
                     .unwrap()
                     .install(|| {
-                        match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &MatchConfig::default())
+                        match_descriptors(&dl, l.keypoints(), &dr, r.keypoints(), &MatchConfig::default(), &rows(24.0))
                     })
             };
             let one = on(1);

@@ -4,9 +4,16 @@
 //! pixel at the image corners, while DoG extrema are localised to a few tenths of a pixel
 //! (and at 2ᵒ-pixel steps in octave `o`). So each match is re-localised: the left point is
 //! snapped to its nearest octave-0 pixel, and the right point is moved to where a window of
-//! the right magnitude plane best matches the left window (Lucas-Kanade, translation only,
-//! inverse-compositional, with gain and offset compensation, since the two cameras' exposures
-//! differ). Only the geometry of the point pair matters to the estimator, so fixing the left
+//! the right magnitude plane best matches the left window (Lucas-Kanade, inverse-compositional,
+//! with gain and offset compensation, since the two cameras' exposures differ). The right
+//! window is not a translated copy of the left one on a verged head: turning a camera by the
+//! verge maps its image by a homography, which stretches and shears a window by several per
+//! cent at 10-20° (the horizontal scale is 1/cos² of the angle off the axis), and a
+//! translation fitted across such a window moves with the texture's asymmetry. So the left
+//! window (the template) is sampled through the inverse of the homography's local linear map
+//! (the caller's [`Warp`]), which makes it the right window's shape, and only the translation
+//! of the right window is estimated; the template is sampled once per match, so the
+//! iterations keep the translated window's fast sampling. Only the geometry of the point pair matters to the estimator, so fixing the left
 //! point at an integer pixel loses nothing and keeps the interpolation on one side.
 //!
 //! Matches whose window has too little vertical structure (the vertical position would be
@@ -44,6 +51,19 @@ impl Default for SubpixelConfig {
     }
 }
 
+/// The local linear map from the left window's offsets to the right window's, row-major:
+/// `[dx_r, dy_r] = [[a, b], [c, d]] · [dx_l, dy_l]`. The identity on a parallel head.
+pub type Warp = [f32; 4];
+
+/// The identity [`Warp`]: the right window a translated copy of the left one.
+pub const IDENTITY: Warp = [1.0, 0.0, 0.0, 1.0];
+
+/// A warp whose largest displacement of a window sample, against the identity's, stays below
+/// this (pixels) is taken as the identity: the template is then read from whole pixels, with
+/// no interpolation, and a hundredth of a pixel at the window's edge is below what the
+/// refinement resolves (the u8 magnitudes limit it to a few hundredths).
+const WARP_NEGLIGIBLE_PX: f32 = 0.01;
+
 /// A refined point pair in octave-0 (full-resolution) pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefinedPair {
@@ -60,7 +80,7 @@ pub struct RefinedPair {
 /// fractional weights: the bounds are checked once and the loop is four loads and a blend,
 /// over four equal-length row slices so that it compiles to vector code without bounds checks.
 /// `None` when the window (plus its interpolation neighbours) leaves the plane.
-fn sample_window(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> Option<()> {
+fn sample_translated(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> Option<()> {
     let (w, h) = (p.width() as i32, p.height() as i32);
     let (x0, y0) = ((x - half as f32).floor(), (y - half as f32).floor());
     let (ix, iy) = (x0 as i32, y0 as i32);
@@ -87,6 +107,52 @@ fn sample_window(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> 
     Some(())
 }
 
+/// [`sample_translated`] through `warp`: sample `(c, r)` of the window (offsets from its centre)
+/// is taken at `(x, y) + warp · (c, r)`, each sample with its own interpolation weights.
+fn sample_warped(
+    p: &SobelPlane,
+    x: f32,
+    y: f32,
+    half: i32,
+    warp: &Warp,
+    out: &mut [f32],
+) -> Option<()> {
+    let [a, b, c, d] = *warp;
+    let h = half as f32;
+    // The window's extreme sample positions are at its corners (the map is linear).
+    let reach_x = (a.abs() + b.abs()) * h;
+    let reach_y = (c.abs() + d.abs()) * h;
+    let (w, hh) = (p.width() as f32, p.height() as f32);
+    if !(x.is_finite() && y.is_finite())
+        || x - reach_x < 0.0
+        || y - reach_y < 0.0
+        || x + reach_x + 1.0 >= w
+        || y + reach_y + 1.0 >= hh
+    {
+        return None;
+    }
+    let (m, stride) = (p.magnitude(), p.width() as usize);
+    let side = (2 * half + 1) as usize;
+    for (r, row_out) in out.chunks_exact_mut(side).enumerate() {
+        let dy = r as f32 - h;
+        let (mut sx, mut sy) = (x - a * h + b * dy, y - c * h + d * dy);
+        for o in row_out.iter_mut() {
+            let (fx, fy) = (sx.floor(), sy.floor());
+            let (ix, iy) = (fx as usize, fy as usize);
+            let (tx, ty) = (sx - fx, sy - fy);
+            let at = iy * stride + ix;
+            let (p00, p01) = (f32::from(m[at]), f32::from(m[at + 1]));
+            let (p10, p11) = (f32::from(m[at + stride]), f32::from(m[at + stride + 1]));
+            let top = p00 + tx * (p01 - p00);
+            let bottom = p10 + tx * (p11 - p10);
+            *o = top + ty * (bottom - top);
+            sx += a;
+            sy += c;
+        }
+    }
+    Some(())
+}
+
 thread_local! {
     /// [`refine_pair`]'s working arrays, kept per thread between calls: a match needs seven
     /// window-sized arrays, and taking them from here spares their allocation (or the zeroing
@@ -95,12 +161,14 @@ thread_local! {
     static SCRATCH: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
 }
 
-/// Refines one match: `left` / `right` in full-resolution pixels. `None` when rejected.
+/// Refines one match: `left` / `right` in full-resolution pixels, `warp` the local map from the
+/// left window to the right one ([`IDENTITY`] on a parallel head). `None` when rejected.
 pub fn refine_pair(
     left_plane: &SobelPlane,
     right_plane: &SobelPlane,
     left: [f32; 2],
     right: [f32; 2],
+    warp: &Warp,
     config: &SubpixelConfig,
 ) -> Option<RefinedPair> {
     let half = i32::try_from(config.half_window).ok()?;
@@ -111,17 +179,21 @@ pub fn refine_pair(
     }
     // Inside the plane, so the window side is small enough for any arithmetic below.
     let side = (2 * half + 1) as usize;
-    let len = SCRATCH_ARRAYS * side * side;
+    let len = SCRATCH_ARRAYS * side * side + (side + 2) * (side + 2);
     let mut scratch = SCRATCH.take();
     if scratch.len() < len {
         scratch.resize(len, 0.0);
     }
+    let [a, b, c, d] = *warp;
+    let off = ((a - 1.0).abs() + b.abs() + c.abs() + (d - 1.0).abs()) * half as f32;
+    let warp = (off >= WARP_NEGLIGIBLE_PX).then_some(warp);
     let refined = refine_in(
         left_plane,
         right_plane,
         left,
         [lx, ly],
         right,
+        warp,
         config,
         &mut scratch[..len],
     );
@@ -129,7 +201,7 @@ pub fn refine_pair(
     refined
 }
 
-/// Window-sized arrays [`refine_in`] works in.
+/// Window-sized arrays [`refine_in`] works in (besides the warped template with its border).
 const SCRATCH_ARRAYS: usize = 7;
 
 /// The sum of each of `arrays`, taken in eight interleaved partial sums that are added
@@ -172,48 +244,89 @@ fn mean_and_norm(window: &[f32], squares: &mut [f32]) -> (f32, f32) {
 }
 
 /// [`refine_pair`] with the left point snapped to `[lx, ly]`, whose window plus a one-pixel
-/// border lies inside the plane, and `buffer` [`SCRATCH_ARRAYS`] window sizes long.
+/// border lies inside the plane, `warp` `None` for the identity, and `buffer`
+/// [`SCRATCH_ARRAYS`] window sizes and one bordered window long.
+#[allow(clippy::too_many_arguments)]
 fn refine_in(
     left_plane: &SobelPlane,
     right_plane: &SobelPlane,
     left: [f32; 2],
     [lx, ly]: [i32; 2],
     right: [f32; 2],
+    warp: Option<&Warp>,
     config: &SubpixelConfig,
     buffer: &mut [f32],
 ) -> Option<RefinedPair> {
     let half = config.half_window as i32;
     let side = (2 * half + 1) as usize;
     let n = side * side;
+    let (windows, bordered) = buffer.split_at_mut(SCRATCH_ARRAYS * n);
     // Template, its two gradients, the warped right window and three arrays of terms.
-    let mut arrays = buffer.chunks_exact_mut(n);
+    let mut arrays = windows.chunks_exact_mut(n);
     let [t, gx, gy, warped, p0, p1, p2] =
         std::array::from_fn(|_| arrays.next().unwrap_or_default());
-    // Template, its gradient (central differences) and zero-mean form. Row slices (the row
-    // with its left and right neighbours, the rows above and below) let the loop run
-    // without bounds checks.
-    let (m, stride) = (left_plane.magnitude(), left_plane.width() as usize);
-    let (x0, y0) = ((lx - half) as usize, (ly - half) as usize);
-    for (r, ((t_row, gx_row), gy_row)) in t
+    // Template, its gradient (central differences) and zero-mean form, read from the left
+    // plane's pixels or, through a warp, from its bordered window sampled through the
+    // warp's inverse (in the right image's frame). Row slices (the row with its left and
+    // right neighbours, the rows above and below) let the loop run without bounds checks.
+    let cells = t
         .chunks_exact_mut(side)
         .zip(gx.chunks_exact_mut(side))
-        .zip(gy.chunks_exact_mut(side))
-        .enumerate()
-    {
-        let row = &m[(y0 + r) * stride + x0 - 1..][..side + 2];
-        let above = &m[(y0 + r - 1) * stride + x0..][..side];
-        let below = &m[(y0 + r + 1) * stride + x0..][..side];
-        let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
-        let cells = t_row
-            .iter_mut()
-            .zip(gx_row.iter_mut())
-            .zip(gy_row.iter_mut());
-        for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
-            cells.zip(horizontal).zip(above.iter().zip(below))
-        {
-            *tv = f32::from(c);
-            *gxv = 0.5 * (f32::from(r) - f32::from(l));
-            *gyv = 0.5 * (f32::from(b) - f32::from(a));
+        .zip(gy.chunks_exact_mut(side));
+    match warp {
+        None => {
+            let (m, stride) = (left_plane.magnitude(), left_plane.width() as usize);
+            let (x0, y0) = ((lx - half) as usize, (ly - half) as usize);
+            for (r, ((t_row, gx_row), gy_row)) in cells.enumerate() {
+                let row = &m[(y0 + r) * stride + x0 - 1..][..side + 2];
+                let above = &m[(y0 + r - 1) * stride + x0..][..side];
+                let below = &m[(y0 + r + 1) * stride + x0..][..side];
+                let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
+                let cells = t_row
+                    .iter_mut()
+                    .zip(gx_row.iter_mut())
+                    .zip(gy_row.iter_mut());
+                for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
+                    cells.zip(horizontal).zip(above.iter().zip(below))
+                {
+                    *tv = f32::from(c);
+                    *gxv = 0.5 * (f32::from(r) - f32::from(l));
+                    *gyv = 0.5 * (f32::from(b) - f32::from(a));
+                }
+            }
+        }
+        Some(&[a, b, c, d]) => {
+            let det = a * d - b * c;
+            if !(det.is_finite() && det.abs() > f32::EPSILON) {
+                return None;
+            }
+            let inverse = [d / det, -b / det, -c / det, a / det];
+            sample_warped(
+                left_plane,
+                lx as f32,
+                ly as f32,
+                half + 1,
+                &inverse,
+                bordered,
+            )?;
+            let stride = side + 2;
+            for (r, ((t_row, gx_row), gy_row)) in cells.enumerate() {
+                let row = &bordered[(r + 1) * stride..][..stride];
+                let above = &bordered[r * stride + 1..][..side];
+                let below = &bordered[(r + 2) * stride + 1..][..side];
+                let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
+                let cells = t_row
+                    .iter_mut()
+                    .zip(gx_row.iter_mut())
+                    .zip(gy_row.iter_mut());
+                for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
+                    cells.zip(horizontal).zip(above.iter().zip(below))
+                {
+                    *tv = c;
+                    *gxv = 0.5 * (r - l);
+                    *gyv = 0.5 * (b - a);
+                }
+            }
         }
     }
     let (t_mean, t_norm) = mean_and_norm(t, p0);
@@ -232,15 +345,14 @@ fn refine_in(
     if det.is_nan() || det <= 1e-6 * (hxx + hyy).powi(2) || t_norm <= 0.0 {
         return None;
     }
-    // Start: the right point shifted by the same amount the left one was snapped.
-    let start = [
-        right[0] + (lx as f32 - left[0]),
-        right[1] + (ly as f32 - left[1]),
-    ];
+    // Start: the right point shifted by what the left one was snapped, mapped by the warp.
+    let [a, b, c, d] = *warp.unwrap_or(&IDENTITY);
+    let (sx, sy) = (lx as f32 - left[0], ly as f32 - left[1]);
+    let start = [right[0] + a * sx + b * sy, right[1] + c * sx + d * sy];
     let mut p = start;
     let mut converged = false;
     for _ in 0..config.max_iterations {
-        sample_window(right_plane, p[0], p[1], half, warped)?;
+        sample_translated(right_plane, p[0], p[1], half, warped)?;
         let (mean, norm) = mean_and_norm(warped, p0);
         if norm <= 0.0 {
             return None;
@@ -272,7 +384,7 @@ fn refine_in(
         return None;
     }
     // Quality at the solution: correlation and the vertical position uncertainty.
-    sample_window(right_plane, p[0], p[1], half, warped)?;
+    sample_translated(right_plane, p[0], p[1], half, warped)?;
     let (mean, norm) = mean_and_norm(warped, p0);
     if norm <= 0.0 {
         return None;
@@ -423,6 +535,7 @@ pub fn guided_pair(
     left: [f32; 2],
     guess: [f32; 2],
     search_px: i32,
+    warp: &Warp,
     config: &SubpixelConfig,
 ) -> Option<RefinedPair> {
     let half = i32::try_from(config.half_window).ok()?;
@@ -452,6 +565,7 @@ pub fn guided_pair(
         right_plane,
         [lx as f32, ly as f32],
         [(gx + best_dx) as f32, gy as f32],
+        warp,
         config,
     )
 }
@@ -505,6 +619,7 @@ mod tests {
                 &r,
                 [x, y],
                 [x - 3.0, y + 0.5],
+                &IDENTITY,
                 &SubpixelConfig::default(),
             )
             .unwrap();
@@ -527,6 +642,7 @@ mod tests {
             [50.0, 30.0],
             [47.0, 30.0],
             8,
+            &IDENTITY,
             &SubpixelConfig::default(),
         )
         .unwrap();
@@ -626,13 +742,13 @@ mod tests {
         let l = plane(120, 90, 0.0, 0.0, 1.0);
         let r = plane(120, 90, -3.37, 0.21, 0.9);
         let default = SubpixelConfig::default();
-        let first = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &default).unwrap();
+        let first = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &IDENTITY, &default).unwrap();
         // A larger window grows this thread's scratch arrays and leaves its values in them.
         let config = SubpixelConfig {
             half_window: 12,
             ..default
         };
-        let got = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &config).unwrap();
+        let got = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &IDENTITY, &config).unwrap();
         assert!(
             (got.right[0] - (got.left[0] - 3.37)).abs() < 0.05,
             "{got:?}"
@@ -641,7 +757,7 @@ mod tests {
             (got.right[1] - (got.left[1] + 0.21)).abs() < 0.05,
             "{got:?}"
         );
-        let again = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &default).unwrap();
+        let again = refine_pair(&l, &r, [60.3, 45.6], [57.0, 46.0], &IDENTITY, &default).unwrap();
         assert_eq!(format!("{first:?}"), format!("{again:?}"));
         // Windows that cannot fit the plane, however large the configured value, are rejected.
         for half_window in [60, usize::MAX] {
@@ -649,8 +765,10 @@ mod tests {
                 half_window,
                 ..default
             };
-            assert!(refine_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], &config).is_none());
-            assert!(guided_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], 4, &config).is_none());
+            assert!(refine_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], &IDENTITY, &config).is_none());
+            assert!(
+                guided_pair(&l, &r, [60.0, 45.0], [57.0, 45.0], 4, &IDENTITY, &config).is_none()
+            );
         }
     }
 
@@ -662,12 +780,19 @@ mod tests {
             &flat,
             [20.0, 20.0],
             [20.0, 20.0],
+            &IDENTITY,
             &SubpixelConfig::default()
         )
         .is_none());
         let l = plane(40, 40, 0.0, 0.0, 1.0);
-        assert!(
-            refine_pair(&l, &l, [3.0, 20.0], [3.0, 20.0], &SubpixelConfig::default()).is_none()
-        );
+        assert!(refine_pair(
+            &l,
+            &l,
+            [3.0, 20.0],
+            [3.0, 20.0],
+            &IDENTITY,
+            &SubpixelConfig::default()
+        )
+        .is_none());
     }
 }

@@ -6,6 +6,7 @@
 use clap::{Args, ValueEnum};
 use stereocal::descriptor::DescriptorMode;
 use stereocal::estimator::Model;
+use stereocal::matching::Gate;
 use stereocal::misalignment::WindowConfig;
 use stereocal::session::SessionConfig;
 use stereocal_hdl::regs::output_mode::SobelOutput;
@@ -68,10 +69,11 @@ pub struct EstimateArgs {
     /// Left-right consistency off: a left point's best right match need not choose it back.
     #[arg(long)]
     no_cross_check: bool,
-    /// Vertical-disparity gate: right candidates within this many pixels of the left point's
-    /// row (full resolution).
-    #[arg(long, default_value_t = 24.0, value_parser = parse_pixels)]
-    max_vertical_px: f32,
+    /// Vertical-disparity gate of a fixed width: right candidates within this many pixels of
+    /// the left point's row (full resolution). Default: the epipolar band the calibration, the
+    /// image size and the head's range of poses allow.
+    #[arg(long, value_parser = parse_pixels)]
+    max_vertical_px: Option<f32>,
     /// No vertical-disparity gate: every right point is a candidate.
     #[arg(long, conflicts_with = "max_vertical_px")]
     no_vertical_gate: bool,
@@ -106,7 +108,11 @@ impl EstimateArgs {
         e.matching.ratio = self.ratio;
         e.matching.best_n = self.best;
         e.matching.cross_check = !self.no_cross_check;
-        e.matching.max_vertical_px = (!self.no_vertical_gate).then_some(self.max_vertical_px);
+        e.matching.gate = match (self.no_vertical_gate, self.max_vertical_px) {
+            (true, _) => Gate::Off,
+            (false, Some(px)) => Gate::Rows(px),
+            (false, None) => Gate::Epipolar,
+        };
         e.descriptor.mode = match self.descriptor {
             DescriptorArg::Full => DescriptorMode::Full128,
             DescriptorArg::Reduced16 => DescriptorMode::Reduced16,

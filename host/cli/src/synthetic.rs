@@ -30,6 +30,19 @@ pub struct SceneArgs {
     trajectory: Option<TrajectoryKind>,
     #[command(flatten)]
     size: SizeArgs,
+    /// The verge the `fixed` trajectory holds, degrees (toe-in positive).
+    #[arg(long, default_value_t = stereocal_synth::FIXED_VERGE_DEG, allow_negative_numbers = true)]
+    verge: f64,
+    /// The left camera's focal length in pixels (default: a 56° horizontal field of view).
+    #[arg(long)]
+    focal: Option<f64>,
+    /// Distance between the optical centres, metres.
+    #[arg(long, default_value_t = stereocal_synth::BASELINE_M)]
+    baseline: f64,
+    /// The right camera's fixed pitch, degrees, not written into calib.toml (a misalignment
+    /// for `--model general` to find).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pitch: f64,
 }
 
 impl SceneArgs {
@@ -41,6 +54,10 @@ impl SceneArgs {
             config.trajectory = t;
         }
         self.size.apply(&mut config);
+        config.fixed_verge_deg = self.verge;
+        config.focal_px = self.focal;
+        config.baseline_m = self.baseline;
+        config.right_pitch_deg = self.pitch;
         Sequence::builtin(self.scene, config)
             .with_context(|| format!("cannot build the `{}` sequence", self.scene))
     }
@@ -114,6 +131,10 @@ pub fn demo(args: &DemoArgs) -> anyhow::Result<()> {
         seed: args.seed,
         trajectory: Some(TrajectoryKind::Manual),
         size: SizeArgs::default(),
+        verge: stereocal_synth::FIXED_VERGE_DEG,
+        focal: None,
+        baseline: stereocal_synth::BASELINE_M,
+        pitch: 0.0,
     };
     let sequence = scene.sequence()?;
     let title = format!(

@@ -87,11 +87,9 @@ fn every_optional_mode_estimates_the_verge() {
         (&["--ratio", "0.4"], Effect::FewerMatches, 0.05),
         (&["--best", "100"], Effect::Matches(100.0), 0.05),
         (&["--no-ransac"], Effect::SameMatchesOtherEstimates, 0.05),
-        (
-            &["--model", "general"],
-            Effect::SameMatchesOtherEstimates,
-            0.05,
-        ),
+        // The general model fits a relative pitch and roll, so its matching band lets more of
+        // them through: other matches.
+        (&["--model", "general"], Effect::OtherMatches, 0.05),
         (
             &["--misalignment", "window"],
             Effect::SameMatchesOtherEstimates,

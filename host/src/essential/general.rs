@@ -84,6 +84,15 @@ impl RelativePose {
         }
     }
 
+    /// The yaws of the verge head nearest this pose: the left one is the azimuth of the right
+    /// camera's centre in the left camera's frame (the constrained model's `alpha_l`, see
+    /// [`Extrinsics`]), the right one that less the verge.
+    pub fn yaws(&self) -> VergeAngles {
+        let centre = self.rotation.inverse() * self.baseline.as_ref();
+        let alpha_l = centre.z.atan2(centre.x);
+        VergeAngles::new(alpha_l, alpha_l - self.verge())
+    }
+
     /// The verge angle (radians, toe-in positive) = `-yaw` of `R_01`.
     pub fn verge(&self) -> f64 {
         -self.yaw_pitch_roll().yaw
@@ -250,6 +259,10 @@ mod tests {
     fn verge_pose_matches_the_constrained_essential() {
         let a = VergeAngles::new(0.05, -0.02);
         let p = RelativePose::from_verge(a);
+        let back = p.yaws();
+        assert!(
+            (back.alpha_l - a.alpha_l).abs() < 1e-14 && (back.alpha_r - a.alpha_r).abs() < 1e-14
+        );
         assert!((p.essential() - a.essential()).norm() < 1e-14);
         assert!((p.verge() - a.verge()).abs() < 1e-14);
         let ypr = p.yaw_pitch_roll();

@@ -23,12 +23,21 @@ impl Intrinsics {
     /// two cameras, so that downstream code that assumes a centred or shared principal point
     /// is caught by the ground truth.
     pub fn default_for(width: u32, height: u32, side: Side) -> Self {
+        Self::for_sensor(width, height, None, side)
+    }
+
+    /// [`Intrinsics::default_for`] with the left camera's focal length `focal_px` (the right
+    /// one's longer by the same 3.5/600 of it as at the default), or the default's when `None`.
+    pub fn for_sensor(width: u32, height: u32, focal_px: Option<f64>, side: Side) -> Self {
         let scale = f64::from(width) / 640.0;
         let (df, dcx, dcy) = match side {
             Side::Left => (0.0, 2.4, -1.9),
             Side::Right => (3.5, -2.1, 1.6),
         };
-        let f = 600.0 * scale + df;
+        let f = match focal_px {
+            Some(f) => f * (1.0 + df / 600.0),
+            None => 600.0 * scale + df,
+        };
         Intrinsics {
             fx: f,
             fy: f,

@@ -2,7 +2,7 @@
 //! injection into real pairs.
 //!
 //! The renderer ([`Sequence`]) ray-casts a deterministic (seeded ChaCha) 3D scene through two
-//! pinhole cameras on a verge head (baseline 0.3 m, right camera at +x, each camera yawing about
+//! pinhole cameras on a verge head (baseline 0.3 m by default, right camera at +x, each camera yawing about
 //! its own vertical axis; verge = alpha_l - alpha_r, toe-in positive), optionally tilted and
 //! driven along a road. Projection and occlusion are exact; only the pixel integration is
 //! sampled (see `render.rs`), so the truth it reports is the truth in the pixels.
@@ -25,7 +25,7 @@ pub use rendered::{
     Frames, Sequence, SequenceConfig, StereoFrame, StereoImages, Truth, BASELINE_M,
 };
 pub use scene::{Material, Pattern, Scene, SceneBox, SceneKind, Sky, Surface, TextureKind};
-pub use trajectory::{HeadState, Trajectory, TrajectoryKind, FIXED_VERGE_DEG};
+pub use trajectory::{HeadGeometry, HeadState, Trajectory, TrajectoryKind, FIXED_VERGE_DEG};
 
 /// Why a synthetic sequence could not be made or written.
 #[derive(Debug, thiserror::Error)]

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use crate::camera::{CameraPose, Intrinsics, Side};
 use crate::render::{render, MotionBlur, RenderSpec, RowMap, Supersampling};
 use crate::scene::{Scene, SceneKind};
-use crate::trajectory::{HeadState, Trajectory, TrajectoryKind};
+use crate::trajectory::{HeadGeometry, HeadState, Trajectory, TrajectoryKind, FIXED_VERGE_DEG};
 use crate::SynthError;
 use stereocal::output::output_dir::StagingDir;
 
@@ -51,6 +51,17 @@ pub struct SequenceConfig {
     pub speed_mps: f64,
     /// Head pitch, positive looking down (degrees).
     pub tilt_deg: f64,
+    /// Focal length of the left camera in pixels (the right one's is 3.5 px longer, scaled
+    /// alike); `None`: a 56° horizontal field of view, 600 px at 640 px width.
+    pub focal_px: Option<f64>,
+    /// Distance between the optical centres, right camera at +x.
+    pub baseline_m: f64,
+    /// The verge the `fixed` trajectory holds, split evenly between the cameras (degrees).
+    pub fixed_verge_deg: f64,
+    /// The right camera's fixed pitch relative to the left one, `R_01 = Ry(-verge) Rx(pitch)`
+    /// as the calibration's `[extrinsics]` define it (degrees). It is not written into
+    /// `calib.toml`: it is the misalignment a head has and its calibration does not know.
+    pub right_pitch_deg: f64,
 }
 
 impl SequenceConfig {
@@ -73,6 +84,10 @@ impl SequenceConfig {
             head_start: [0.0, -1.3, 0.0],
             speed_mps: 10.0,
             tilt_deg: 2.0,
+            focal_px: None,
+            baseline_m: BASELINE_M,
+            fixed_verge_deg: FIXED_VERGE_DEG,
+            right_pitch_deg: 0.0,
         };
         match kind {
             SceneKind::Road => base,
@@ -151,6 +166,29 @@ impl SequenceConfig {
         }
         if !self.speed_mps.is_finite() {
             return bad("speed_mps", "must be finite".into());
+        }
+        if let Some(f) = self.focal_px {
+            if !(f.is_finite() && f > 0.0) {
+                return bad("focal_px", format!("is {f}, must be finite and > 0"));
+            }
+        }
+        if !(self.baseline_m.is_finite() && self.baseline_m > 0.0) {
+            return bad(
+                "baseline_m",
+                format!("is {}, must be finite and > 0", self.baseline_m),
+            );
+        }
+        if !(self.fixed_verge_deg.is_finite() && self.fixed_verge_deg.abs() < 60.0) {
+            return bad(
+                "fixed_verge_deg",
+                format!("is {}, must be within ±60°", self.fixed_verge_deg),
+            );
+        }
+        if !(self.right_pitch_deg.is_finite() && self.right_pitch_deg.abs() < 30.0) {
+            return bad(
+                "right_pitch_deg",
+                format!("is {}, must be within ±30°", self.right_pitch_deg),
+            );
         }
         if !(self.tilt_deg.is_finite() && self.tilt_deg.abs() < 80.0) {
             return bad(
@@ -237,6 +275,7 @@ impl Sequence {
             Vector3::from(config.head_start),
             config.speed_mps,
             config.tilt_deg,
+            config.fixed_verge_deg,
         );
         let [z_lo, z_hi] = scene.extent_z();
         let (z0, z1) = (trajectory.z_at(0.0), trajectory.z_at(duration_s));
@@ -249,8 +288,8 @@ impl Sequence {
             });
         }
         let intrinsics = [
-            Intrinsics::default_for(config.width, config.height, Side::Left),
-            Intrinsics::default_for(config.width, config.height, Side::Right),
+            Intrinsics::for_sensor(config.width, config.height, config.focal_px, Side::Left),
+            Intrinsics::for_sensor(config.width, config.height, config.focal_px, Side::Right),
         ];
         Ok(Sequence {
             scene,
@@ -282,7 +321,7 @@ impl Sequence {
     }
 
     pub fn baseline_m(&self) -> f64 {
-        BASELINE_M
+        self.config.baseline_m
     }
 
     /// Size of the delivered images (a field is half the frame height).
@@ -307,6 +346,14 @@ impl Sequence {
         match parity {
             Some(p) => self.intrinsics.map(|k| k.field(p)),
             None => self.intrinsics,
+        }
+    }
+
+    /// The head's fixed geometry: baseline and the right camera's pitch.
+    fn head(&self) -> HeadGeometry {
+        HeadGeometry {
+            baseline_m: self.config.baseline_m,
+            right_pitch_rad: self.config.right_pitch_deg.to_radians(),
         }
     }
 
@@ -356,7 +403,7 @@ impl Sequence {
         Ok(self
             .trajectory
             .state(self.time_s(index))
-            .camera_poses(BASELINE_M, l, r))
+            .camera_poses(self.head(), l, r))
     }
 
     /// Render frame `index` (both cameras, each parallel over rows).
@@ -404,7 +451,7 @@ impl Sequence {
             .iter()
             .map(|&ti| {
                 let [l, r] = self.intrinsics;
-                self.trajectory.state(ti).camera_poses(BASELINE_M, l, r)
+                self.trajectory.state(ti).camera_poses(self.head(), l, r)
             })
             .collect();
         let rows = match self.parity(index) {
@@ -451,7 +498,7 @@ impl Sequence {
             },
             c.seed
         );
-        let _ = writeln!(s, "baseline_m = {BASELINE_M:?}");
+        let _ = writeln!(s, "baseline_m = {:?}", c.baseline_m);
         for (name, k) in [("left", l), ("right", r)] {
             let _ = writeln!(s, "\n[{name}]");
             let _ = writeln!(

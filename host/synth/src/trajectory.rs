@@ -26,7 +26,8 @@ use crate::SynthError;
 pub enum TrajectoryKind {
     /// Thesis fig. 5.1: one camera at a time moved by hand, ±15° verge, with pauses.
     Manual,
-    /// Thesis fig. 5.2: verge held at 1.6°, vehicle moving (with a small pitch bounce).
+    /// Thesis fig. 5.2: verge held (at 1.6° unless configured), vehicle moving (with a small
+    /// pitch bounce).
     Fixed,
     /// A fixed list of verge values, two seconds each, instantaneous switches.
     Steps,
@@ -83,14 +84,18 @@ impl HeadState {
     }
 
     /// The two cameras: each yaws about its own vertical axis through its optical centre; the
-    /// right one sits at `(+baseline, 0, 0)` in the head frame.
+    /// right one sits at `(+baseline, 0, 0)` in the head frame and carries the head's fixed
+    /// pitch after its yaw (`Ry(alpha_r) Rx(pitch)`, `docs/ARCHITECTURE.md`, "Fixed
+    /// misalignments").
     pub fn camera_poses(
         &self,
-        baseline_m: f64,
+        geometry: HeadGeometry,
         left: Intrinsics,
         right: Intrinsics,
     ) -> [CameraPose; 2] {
         let head = pitch_down(self.tilt_rad);
+        // `pitch_down(a)` is `Rx(-a)` of the library's convention.
+        let misaligned = pitch_down(-geometry.right_pitch_rad);
         [
             CameraPose {
                 intrinsics: left,
@@ -99,11 +104,19 @@ impl HeadState {
             },
             CameraPose {
                 intrinsics: right,
-                center: self.position + head * Vector3::new(baseline_m, 0.0, 0.0),
-                rotation: head * yaw(self.alpha_r_rad),
+                center: self.position + head * Vector3::new(geometry.baseline_m, 0.0, 0.0),
+                rotation: head * yaw(self.alpha_r_rad) * misaligned,
             },
         ]
     }
+}
+
+/// What of the head does not move: the baseline and the right camera's fixed pitch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadGeometry {
+    pub baseline_m: f64,
+    /// Positive as the calibration's `pitch_deg` (radians).
+    pub right_pitch_rad: f64,
 }
 
 /// A keyframe of the camera yaws (degrees); consecutive keys are joined by a cosine ease, so a
@@ -150,7 +163,7 @@ const STEP_HOLD_S: f64 = 2.0;
 impl Trajectory {
     /// A trajectory of `kind` covering at least `duration_s` seconds, starting with the left
     /// optical centre at `start` and moving along +z at `speed_mps`, the head tilted down by
-    /// `tilt_deg`.
+    /// `tilt_deg`; `fixed_verge_deg` is the verge `Fixed` holds.
     pub fn new(
         kind: TrajectoryKind,
         seed: u64,
@@ -158,6 +171,7 @@ impl Trajectory {
         start: Vector3<f64>,
         speed_mps: f64,
         tilt_deg: f64,
+        fixed_verge_deg: f64,
     ) -> Self {
         let (keys, between) = match kind {
             TrajectoryKind::Manual => (manual_keys(seed, duration_s, hand_speed), Between::Ease),
@@ -165,8 +179,8 @@ impl Trajectory {
             TrajectoryKind::Fixed => (
                 vec![Key {
                     t_s: 0.0,
-                    alpha_l_deg: FIXED_VERGE_DEG / 2.0,
-                    alpha_r_deg: -FIXED_VERGE_DEG / 2.0,
+                    alpha_l_deg: fixed_verge_deg / 2.0,
+                    alpha_r_deg: -fixed_verge_deg / 2.0,
                 }],
                 Between::Hold,
             ),
@@ -304,7 +318,15 @@ mod tests {
     use super::*;
 
     fn make(kind: TrajectoryKind, seed: u64) -> Trajectory {
-        Trajectory::new(kind, seed, 60.0, Vector3::zeros(), 0.0, 0.0)
+        Trajectory::new(
+            kind,
+            seed,
+            60.0,
+            Vector3::zeros(),
+            0.0,
+            0.0,
+            FIXED_VERGE_DEG,
+        )
     }
 
     #[test]
@@ -362,8 +384,26 @@ mod tests {
 
     #[test]
     fn fixed_and_steps() {
-        let f = Trajectory::new(TrajectoryKind::Fixed, 0, 10.0, Vector3::zeros(), 10.0, 2.0);
+        let f = Trajectory::new(
+            TrajectoryKind::Fixed,
+            0,
+            10.0,
+            Vector3::zeros(),
+            10.0,
+            2.0,
+            FIXED_VERGE_DEG,
+        );
         assert!((f.state(3.7).verge_deg() - FIXED_VERGE_DEG).abs() < 1e-12);
+        let wide = Trajectory::new(
+            TrajectoryKind::Fixed,
+            0,
+            1.0,
+            Vector3::zeros(),
+            0.0,
+            0.0,
+            17.5,
+        );
+        assert!((wide.state(0.4).verge_deg() - 17.5).abs() < 1e-12);
         assert!((f.state(2.0).position.z - 20.0).abs() < 1e-12);
         let s = make(TrajectoryKind::Steps, 0);
         assert!((s.state(2.5).verge_deg() - 2.0).abs() < 1e-12);

@@ -23,6 +23,7 @@ fn motor_run(seed: u64, encoder_offset_deg: Option<f64>) -> (f64, usize) {
         nalgebra::Vector3::zeros(),
         0.0,
         0.0,
+        stereocal_synth::FIXED_VERGE_DEG,
     );
     let mut f = VergeFilter::new(KalmanConfig::default());
     let (mut worst, mut restarts) = (0f64, 0);
