@@ -304,7 +304,7 @@ impl<L: Link> Session<L> {
         let encoder_verge_deg = self
             .driver
             .take_encoders(expected)
-            .map(|e| (i64::from(e.left_yaw_udeg) - i64::from(e.right_yaw_udeg)) as f64 * 1e-6);
+            .map(|e| e.verge_udeg() as f64 * 1e-6);
         let start = Instant::now();
         let captured = match &outcome {
             Some(PairOutcome::Pair {

@@ -94,6 +94,12 @@ impl EncodersRepr {
         })
     }
 
+    /// The head's verge at the capture, microdegrees (left yaw minus right yaw, toe-in
+    /// positive), without overflow: each yaw spans the whole `i32`.
+    pub const fn verge_udeg(&self) -> i64 {
+        self.left_yaw_udeg as i64 - self.right_yaw_udeg as i64
+    }
+
     /// Payload length `emit` writes.
     pub const fn buffer_len(&self) -> usize {
         LEN
@@ -112,6 +118,20 @@ impl EncodersRepr {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn verge_is_left_minus_right_over_the_whole_range() {
+        let reading = |l, r| EncodersRepr {
+            frame_id: 0,
+            left_yaw_udeg: l,
+            right_yaw_udeg: r,
+        };
+        assert_eq!(reading(7_500_000, -1_250_000).verge_udeg(), 8_750_000);
+        assert_eq!(
+            reading(i32::MAX, i32::MIN).verge_udeg(),
+            i64::from(i32::MAX) - i64::from(i32::MIN)
+        );
+    }
 
     static PACKET_BYTES: [u8; 12] = [
         0x2a, 0x00, 0x00, 0x00, // frame 42
