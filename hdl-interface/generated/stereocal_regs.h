@@ -131,9 +131,9 @@
 #define STEREOCAL_EDGE_THRESHOLD_R_MIN 1u
 #define STEREOCAL_EDGE_THRESHOLD_R_MAX 31u
 
-/* OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream. */
+/* OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points. */
 #define STEREOCAL_OUTPUT_MODE_OFFSET 0x20u
-#define STEREOCAL_OUTPUT_MODE_RESET 0x00000011u
+#define STEREOCAL_OUTPUT_MODE_RESET 0x05001011u
 /* [0:0] rw: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO. */
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_SHIFT 0u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_WIDTH 1u
@@ -148,6 +148,20 @@
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_RESET 0x1u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_MIN 0u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_MAX 3u
+/* [15:8] rw, valid 1..128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage). */
+#define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_SHIFT 8u
+#define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_WIDTH 8u
+#define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MASK 0x0000FF00u
+#define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_RESET 0x10u
+#define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MIN 1u
+#define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MAX 128u
+/* [26:16] rw, valid 16..1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels). */
+#define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_SHIFT 16u
+#define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_WIDTH 11u
+#define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_MASK 0x07FF0000u
+#define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_RESET 0x500u
+#define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_MIN 16u
+#define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_MAX 1280u
 
 /* POINT_FIFO_LEVEL (ro): Fill level of the point FIFO. */
 #define STEREOCAL_POINT_FIFO_LEVEL_OFFSET 0x24u

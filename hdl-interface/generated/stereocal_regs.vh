@@ -138,9 +138,9 @@ localparam integer SC_EDGE_THRESHOLD_R_WIDTH = 5;
 localparam [31:0] SC_EDGE_THRESHOLD_R_MASK = 32'h0000001F;
 localparam [4:0] SC_EDGE_THRESHOLD_R_RESET = 5'hA;
 
-// OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream.
+// OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points.
 localparam [7:0] SC_OUTPUT_MODE_OFFSET = 8'h20;
-localparam [31:0] SC_OUTPUT_MODE_RESET = 32'h00000011;
+localparam [31:0] SC_OUTPUT_MODE_RESET = 32'h05001011;
 // [0:0] rw: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_LSB = 0;
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_MSB = 0;
@@ -155,6 +155,18 @@ localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_MSB = 5;
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_WIDTH = 2;
 localparam [31:0] SC_OUTPUT_MODE_SOBEL_SCALE_MASK = 32'h00000030;
 localparam [1:0] SC_OUTPUT_MODE_SOBEL_SCALE_RESET = 2'h1;
+// [15:8] rw, valid 1..128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
+localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_LSB = 8;
+localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_MSB = 15;
+localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_WIDTH = 8;
+localparam [31:0] SC_OUTPUT_MODE_POINTS_PER_BATCH_MASK = 32'h0000FF00;
+localparam [7:0] SC_OUTPUT_MODE_POINTS_PER_BATCH_RESET = 8'h10;
+// [26:16] rw, valid 16..1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_LSB = 16;
+localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_MSB = 26;
+localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_WIDTH = 11;
+localparam [31:0] SC_OUTPUT_MODE_ROW_SEGMENT_MASK = 32'h07FF0000;
+localparam [10:0] SC_OUTPUT_MODE_ROW_SEGMENT_RESET = 11'h500;
 
 // POINT_FIFO_LEVEL (ro): Fill level of the point FIFO.
 localparam [7:0] SC_POINT_FIFO_LEVEL_OFFSET = 8'h24;

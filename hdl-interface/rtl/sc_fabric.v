@@ -91,10 +91,12 @@ module sc_fabric #(
     reg  [31:0] latency;
     reg  [31:0] hold_dxdy, hold_dsdog, hold_position;
 
-    // The driver's bit (OUTPUT_MODE.SOBEL_OUTPUT: rows or patches) and the sticky flags' values
-    // are not used by the fabric.
+    // The driver's fields (OUTPUT_MODE.SOBEL_OUTPUT: rows or patches, POINTS_PER_BATCH and
+    // ROW_SEGMENT: how it packs) and the sticky flags' values are not used by the fabric.
     /* verilator lint_off UNUSEDSIGNAL */
     wire        output_mode_sobel_output;
+    wire [7:0]  output_mode_points_per_batch;
+    wire [10:0] output_mode_row_segment;
     /* verilator lint_on UNUSEDSIGNAL */
 
     // Point entry: {octave[1:0], dog, ds, dy, dx (16 bits each), y[10:0], x[10:0]} (88 bits);
@@ -127,6 +129,8 @@ module sc_fabric #(
         .edge_threshold_r(edge_threshold_r),
         .output_mode_sobel_output(output_mode_sobel_output),
         .output_mode_sobel_scale(output_mode_sobel_scale),
+        .output_mode_points_per_batch(output_mode_points_per_batch),
+        .output_mode_row_segment(output_mode_row_segment),
         .point_fifo_level_level(pf_level16), .sobel_fifo_level_level(sf_level16),
         .point_overflow_count_count(pf_dropped32),
         .sobel_overflow_count_count(sf_dropped32),

@@ -48,6 +48,8 @@ module sc_regs (
     output reg  [4:0]  edge_threshold_r, // EDGE_THRESHOLD at 0x1C (rw): [4:0] rw, reset 5'hA
     output reg         output_mode_sobel_output, // OUTPUT_MODE at 0x20 (rw): [0:0] rw, reset 1'h1
     output reg  [1:0]  output_mode_sobel_scale, // [5:4] rw, reset 2'h1
+    output reg  [7:0]  output_mode_points_per_batch, // [15:8] rw, reset 8'h10
+    output reg  [10:0] output_mode_row_segment, // [26:16] rw, reset 11'h500
     input  wire [15:0] point_fifo_level_level, // POINT_FIFO_LEVEL at 0x24 (ro): [15:0] ro
     input  wire [15:0] sobel_fifo_level_level, // SOBEL_FIFO_LEVEL at 0x28 (ro): [15:0] ro
     input  wire [31:0] point_overflow_count_count, // POINT_OVERFLOW_COUNT at 0x2C (ro): [31:0] ro
@@ -74,7 +76,7 @@ module sc_regs (
     output reg  [15:0] max_offset_value // MAX_OFFSET at 0x50 (rw): [15:0] rw, reset 16'h1000
 );
 
-    // bus_wdata bits no writable field takes: 0xFFFF0000.
+    // bus_wdata bits no writable field takes: 0xF8000000.
     wire [5:0] word = bus_addr[7:2];
 
     wire wr_control = bus_we && (word == 6'd1); // CONTROL
@@ -149,7 +151,7 @@ module sc_regs (
         else if (wr_edge_threshold) edge_threshold_r <= bus_wdata[4:0];
     end
 
-    // OUTPUT_MODE (0x20): Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream.
+    // OUTPUT_MODE (0x20): Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points.
     always @(posedge clk) begin
         if (rst) output_mode_sobel_output <= 1'h1;
         else if (wr_output_mode) output_mode_sobel_output <= bus_wdata[0];
@@ -157,6 +159,14 @@ module sc_regs (
     always @(posedge clk) begin
         if (rst) output_mode_sobel_scale <= 2'h1;
         else if (wr_output_mode) output_mode_sobel_scale <= bus_wdata[5:4];
+    end
+    always @(posedge clk) begin
+        if (rst) output_mode_points_per_batch <= 8'h10;
+        else if (wr_output_mode) output_mode_points_per_batch <= bus_wdata[15:8];
+    end
+    always @(posedge clk) begin
+        if (rst) output_mode_row_segment <= 11'h500;
+        else if (wr_output_mode) output_mode_row_segment <= bus_wdata[26:16];
     end
 
     // MAX_OFFSET (0x50): Bound of the sub-pixel refinement (Config::max_offset of the model).
@@ -177,7 +187,7 @@ module sc_regs (
             6'd5: rdata_next = {29'h0, octaves_count}; // OCTAVES
             6'd6: rdata_next = {16'h0, contrast_threshold_value}; // CONTRAST_THRESHOLD
             6'd7: rdata_next = {27'h0, edge_threshold_r}; // EDGE_THRESHOLD
-            6'd8: rdata_next = {26'h0, output_mode_sobel_scale, 3'h0, output_mode_sobel_output}; // OUTPUT_MODE
+            6'd8: rdata_next = {5'h0, output_mode_row_segment, output_mode_points_per_batch, 2'h0, output_mode_sobel_scale, 3'h0, output_mode_sobel_output}; // OUTPUT_MODE
             6'd9: rdata_next = {16'h0, point_fifo_level_level}; // POINT_FIFO_LEVEL
             6'd10: rdata_next = {16'h0, sobel_fifo_level_level}; // SOBEL_FIFO_LEVEL
             6'd11: rdata_next = point_overflow_count_count; // POINT_OVERFLOW_COUNT

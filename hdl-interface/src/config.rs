@@ -23,6 +23,12 @@ pub struct FabricConfig {
     pub sobel_output: SobelOutput,
     /// Gaussian scale feeding the Sobel unit, `0..=3`.
     pub sobel_scale: u8,
+    /// Most points per `PointBatch` packet, `1..=128` (the driver's packing, which the fabric
+    /// does not read).
+    pub points_per_batch: u8,
+    /// Most pixels per `SobelRows` packet, `MIN_SIDE..=MAX_WIDTH`: wider rows go out in
+    /// segments (the driver's packing, which the fabric does not read).
+    pub row_segment: u16,
     /// Largest accepted refinement offset per axis, raw Q2.13, `0..=8191` (4096 = 0.5).
     pub max_offset: u16,
 }
@@ -37,6 +43,8 @@ impl Default for FabricConfig {
             edge_ratio: edge_threshold::R.reset as u8,
             sobel_output: output_mode::SOBEL_OUTPUT_RESET,
             sobel_scale: output_mode::SOBEL_SCALE.reset as u8,
+            points_per_batch: output_mode::POINTS_PER_BATCH.reset as u8,
+            row_segment: output_mode::ROW_SEGMENT.reset as u16,
             max_offset: max_offset::VALUE.reset as u16,
         }
     }
@@ -51,6 +59,8 @@ impl FabricConfig {
         contrast_threshold::VALUE.check(self.contrast_threshold.into())?;
         edge_threshold::R.check(self.edge_ratio.into())?;
         output_mode::SOBEL_SCALE.check(self.sobel_scale.into())?;
+        output_mode::POINTS_PER_BATCH.check(self.points_per_batch.into())?;
+        output_mode::ROW_SEGMENT.check(self.row_segment.into())?;
         max_offset::VALUE.check(self.max_offset.into())?;
         // `octaves` is in 1..=MAX_OCTAVES here, so the shift is small.
         let step = 1u16 << (self.octaves - 1);
@@ -75,6 +85,8 @@ impl FabricConfig {
         bus.write_field(&edge_threshold::R, self.edge_ratio.into())?;
         let mode = output_mode::SOBEL_OUTPUT.insert(0, self.sobel_output.bits())?;
         let mode = output_mode::SOBEL_SCALE.insert(mode, self.sobel_scale.into())?;
+        let mode = output_mode::POINTS_PER_BATCH.insert(mode, self.points_per_batch.into())?;
+        let mode = output_mode::ROW_SEGMENT.insert(mode, self.row_segment.into())?;
         bus.write(output_mode::OFFSET, mode);
         bus.write_field(&max_offset::VALUE, self.max_offset.into())?;
         Ok(())
@@ -100,6 +112,14 @@ impl FabricConfig {
             sobel_scale: narrow(
                 &output_mode::SOBEL_SCALE,
                 output_mode::SOBEL_SCALE.extract(mode),
+            )?,
+            points_per_batch: narrow(
+                &output_mode::POINTS_PER_BATCH,
+                output_mode::POINTS_PER_BATCH.extract(mode),
+            )?,
+            row_segment: narrow(
+                &output_mode::ROW_SEGMENT,
+                output_mode::ROW_SEGMENT.extract(mode),
             )?,
             max_offset: narrow(&max_offset::VALUE, bus.read_field(&max_offset::VALUE))?,
         };
@@ -144,6 +164,8 @@ mod tests {
             edge_ratio: 12,
             sobel_output: SobelOutput::Rows,
             sobel_scale: 2,
+            points_per_batch: 128,
+            row_segment: 100,
             max_offset: 8191,
         };
         config.write_to(&mut bank).unwrap();

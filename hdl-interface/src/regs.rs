@@ -361,21 +361,21 @@ pub mod edge_threshold {
     };
 }
 
-/// Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream. Offset 0x20, rw.
+/// Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points. Offset 0x20, rw.
 pub mod output_mode {
     use crate::{Access, BitRange, Field, Register};
 
     /// Byte offset from [`super::BASE_ADDRESS`].
     pub const OFFSET: u16 = 0x20;
     /// Value after reset.
-    pub const RESET: u32 = 0x0000_0011;
+    pub const RESET: u32 = 0x0500_1011;
     /// Offset, reset and access masks.
     pub const REGISTER: Register = Register {
         name: "OUTPUT_MODE",
         offset: OFFSET,
         reset: RESET,
         ro_mask: 0x0000_0000,
-        rw_mask: 0x0000_0031,
+        rw_mask: 0x07FF_FF31,
         w1c_mask: 0x0000_0000,
         wo_mask: 0x0000_0000,
         pops_on_read: false,
@@ -430,6 +430,28 @@ pub mod output_mode {
         reset: 1,
         min: 0,
         max: 3,
+    };
+
+    /// `[15:8]` rw, reset 16, valid 1..=128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
+    pub const POINTS_PER_BATCH: Field = Field {
+        name: "OUTPUT_MODE.POINTS_PER_BATCH",
+        offset: OFFSET,
+        bits: BitRange { lsb: 8, width: 8 },
+        access: Access::Rw,
+        reset: 16,
+        min: 1,
+        max: 128,
+    };
+
+    /// `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+    pub const ROW_SEGMENT: Field = Field {
+        name: "OUTPUT_MODE.ROW_SEGMENT",
+        offset: OFFSET,
+        bits: BitRange { lsb: 16, width: 11 },
+        access: Access::Rw,
+        reset: 1280,
+        min: 16,
+        max: 1280,
     };
 }
 

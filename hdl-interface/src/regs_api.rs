@@ -162,7 +162,7 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::edge_threshold::R, u32::from(value))
     }
 
-    // OUTPUT_MODE (offset 0x20): Which scale feeds the Sobel unit, and how the soft-core sends the Sobel stream.
+    // OUTPUT_MODE (offset 0x20): Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points.
 
     /// OUTPUT_MODE.SOBEL_OUTPUT `[0:0]` rw, reset 1: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
     fn output_mode_sobel_output(&mut self) -> regs::output_mode::SobelOutput {
@@ -185,6 +185,26 @@ pub trait Registers: RegisterBus {
     /// Writes OUTPUT_MODE.SOBEL_SCALE (`[5:4]` rw, reset 1, valid 0..=3); see [`Self::output_mode_sobel_scale`].
     fn set_output_mode_sobel_scale(&mut self, value: u8) -> Result<(), Error> {
         self.write_field(&regs::output_mode::SOBEL_SCALE, u32::from(value))
+    }
+
+    /// OUTPUT_MODE.POINTS_PER_BATCH `[15:8]` rw, reset 16, valid 1..=128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
+    fn output_mode_points_per_batch(&mut self) -> u8 {
+        self.read_field(&regs::output_mode::POINTS_PER_BATCH) as u8
+    }
+
+    /// Writes OUTPUT_MODE.POINTS_PER_BATCH (`[15:8]` rw, reset 16, valid 1..=128); see [`Self::output_mode_points_per_batch`].
+    fn set_output_mode_points_per_batch(&mut self, value: u8) -> Result<(), Error> {
+        self.write_field(&regs::output_mode::POINTS_PER_BATCH, u32::from(value))
+    }
+
+    /// OUTPUT_MODE.ROW_SEGMENT `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+    fn output_mode_row_segment(&mut self) -> u16 {
+        self.read_field(&regs::output_mode::ROW_SEGMENT) as u16
+    }
+
+    /// Writes OUTPUT_MODE.ROW_SEGMENT (`[26:16]` rw, reset 1280, valid 16..=1280); see [`Self::output_mode_row_segment`].
+    fn set_output_mode_row_segment(&mut self, value: u16) -> Result<(), Error> {
+        self.write_field(&regs::output_mode::ROW_SEGMENT, u32::from(value))
     }
 
     // POINT_FIFO_LEVEL (offset 0x24): Fill level of the point FIFO.

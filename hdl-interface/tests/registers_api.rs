@@ -45,7 +45,13 @@ fn setters_round_trip_and_keep_the_other_fields() {
     assert_eq!(bank.octaves_count(), 2);
     assert_eq!(bank.output_mode_sobel_output(), SobelOutput::Rows);
     assert_eq!(bank.output_mode_sobel_scale(), 3);
-    assert_eq!(bank.read(output_mode::OFFSET), 3 << 4);
+    // The packing fields keep their reset values: 1280-pixel segments, 16 points per batch.
+    assert_eq!(bank.output_mode_points_per_batch(), 16);
+    assert_eq!(bank.output_mode_row_segment(), 1280);
+    assert_eq!(
+        bank.read(output_mode::OFFSET),
+        1280 << 16 | 16 << 8 | 3 << 4
+    );
 }
 
 #[test]

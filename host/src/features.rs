@@ -94,6 +94,12 @@ impl Keypoint {
 }
 
 /// Sobel magnitude and orientation of one octave, row-major.
+///
+/// A plane salvaged from a damaged camera frame lacks the pixels whose packets (rows or row
+/// segments) the link lost: their samples are 0 and [`Self::valid`] says so, and everything
+/// that reads a window of the plane (descriptor windows, sub-pixel windows) skips a window
+/// touching such a pixel, so a lost packet costs the keypoints around it and never feeds
+/// made-up gradients onward.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SobelPlane {
     octave: u8,
@@ -101,6 +107,8 @@ pub struct SobelPlane {
     height: u32,
     magnitude: Vec<u8>,
     orientation: Vec<u8>,
+    /// One flag per pixel, row-major; `None` when every pixel is valid (an intact frame).
+    valid: Option<Vec<bool>>,
 }
 
 impl SobelPlane {
@@ -159,7 +167,51 @@ impl SobelPlane {
             height,
             magnitude,
             orientation,
+            valid: None,
         })
+    }
+
+    /// The plane with only the pixels whose flag in `valid` is set marked valid (`valid`
+    /// holds one flag per pixel, row-major; pixels beyond it are invalid).
+    pub fn with_valid(mut self, mut valid: Vec<bool>) -> Self {
+        valid.resize(self.magnitude.len(), false);
+        self.valid = (!valid.iter().all(|&v| v)).then_some(valid);
+        self
+    }
+
+    /// Whether pixel `(x, y)` holds received gradients (false outside the plane).
+    pub fn valid(&self, x: i64, y: i64) -> bool {
+        if x < 0 || y < 0 || x >= i64::from(self.width) || y >= i64::from(self.height) {
+            return false;
+        }
+        let i = y as usize * self.width as usize + x as usize;
+        self.valid
+            .as_ref()
+            .is_none_or(|v| v.get(i).copied().unwrap_or(false))
+    }
+
+    /// Whether every pixel of the window `xs` x `ys` that lies inside the plane is valid;
+    /// pixels outside the plane are the callers' border checks, not lost data.
+    pub fn window_valid(&self, xs: std::ops::Range<i64>, ys: std::ops::Range<i64>) -> bool {
+        let Some(valid) = &self.valid else {
+            return true;
+        };
+        let (w, h) = (i64::from(self.width), i64::from(self.height));
+        let (x0, x1) = (xs.start.clamp(0, w) as usize, xs.end.clamp(0, w) as usize);
+        let (y0, y1) = (ys.start.clamp(0, h) as usize, ys.end.clamp(0, h) as usize);
+        (y0..y1).all(|y| {
+            let row = y * w as usize;
+            valid
+                .get(row + x0..row + x1)
+                .is_none_or(|v| v.iter().all(|&v| v))
+        })
+    }
+
+    /// Pixels without received gradients (0 for an intact plane).
+    pub fn lost_pixels(&self) -> usize {
+        self.valid
+            .as_ref()
+            .map_or(0, |v| v.iter().filter(|&&v| !v).count())
     }
 
     /// Pyramid octave of the plane (0 = full resolution).
@@ -183,9 +235,10 @@ impl SobelPlane {
         &self.orientation
     }
 
-    /// `(magnitude, orientation)` at integer octave coordinates, `None` outside.
+    /// `(magnitude, orientation)` at integer octave coordinates, `None` outside or on a
+    /// lost pixel.
     pub fn get(&self, x: i32, y: i32) -> Option<(u8, u8)> {
-        if x < 0 || y < 0 || x as u32 >= self.width || y as u32 >= self.height {
+        if !self.valid(x.into(), y.into()) {
             return None;
         }
         let i = y as usize * self.width as usize + x as usize;
@@ -292,9 +345,30 @@ impl FeatureFrame {
         }
     }
 
+    /// Keypoints whose 16×16 gradient window touches a pixel the link lost (0 for an intact
+    /// frame, and in patches mode, where a lost patch is a missing keypoint instead).
+    pub fn keypoints_on_lost_pixels(&self) -> usize {
+        let Gradients::Planes(_) = &self.gradients else {
+            return 0;
+        };
+        let half = (PATCH_SIZE / 2) as i64;
+        self.keypoints
+            .iter()
+            .filter(|kp| {
+                self.plane(kp.octave).is_some_and(|plane| {
+                    let (ox, oy) = kp.octave_position();
+                    let (x0, y0) = (ox.round() as i64 - half, oy.round() as i64 - half);
+                    let side = PATCH_SIZE as i64;
+                    !plane.window_valid(x0..x0 + side, y0..y0 + side)
+                })
+            })
+            .count()
+    }
+
     /// Copies the 16×16 gradient window of keypoint `k` into `out` (row-major, the
     /// [`SobelPatch`] layout; unavailable samples are `(0, 0)`) and returns how many samples
-    /// were available.
+    /// were available: none when the window touches a lost row of its plane, since a
+    /// descriptor from part of a window differs from the whole window's.
     pub fn window(&self, k: usize, out: &mut [(u8, u8); PATCH_SIZE * PATCH_SIZE]) -> usize {
         out.fill((0, 0));
         let Some(kp) = self.keypoints.get(k) else {
@@ -320,6 +394,10 @@ impl FeatureFrame {
                 let (ox, oy) = kp.octave_position();
                 let half = (PATCH_SIZE / 2) as i64;
                 let (x0, y0) = (ox.round() as i64 - half, oy.round() as i64 - half);
+                let side = PATCH_SIZE as i64;
+                if !plane.window_valid(x0..x0 + side, y0..y0 + side) {
+                    return 0;
+                }
                 let (w, h) = (plane.width as i64, plane.height as i64);
                 let xa = x0.max(0);
                 let xb = (x0 + PATCH_SIZE as i64).min(w);

@@ -14,12 +14,12 @@ use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_hdl::FabricConfig;
 
 use crate::calib::Calibration;
-use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome};
+use crate::driver::{Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame};
 use crate::estimator::{EstimatorConfig, FrameEstimate, VergeEstimator};
 use crate::kalman::{KalmanConfig, Measurement, TimeWentBackwards, VergeFilter};
-use crate::link::{FrameInput, InProcessLink, Link, LinkError, Threaded};
+use crate::link::{FrameInput, InProcessLink, Link, LinkError, LinkProtection, Threaded};
 use crate::misalignment::{MisalignmentWindow, WindowConfig};
-use crate::output::record::{FrameRecord, FrameStatus};
+use crate::output::record::{FrameRecord, FrameStatus, LinkLoss};
 use crate::output::summary::RunCost;
 
 /// Settings of a session.
@@ -34,6 +34,8 @@ pub struct SessionConfig {
     /// Learn the head's fixed pitch and roll over a sliding window of frames and refit each
     /// frame's verge with them held (constrained model only); `None`: each frame alone.
     pub misalignment: Option<WindowConfig>,
+    /// How the link is guarded against damage (packing, error correction, loss limit).
+    pub link: LinkProtection,
 }
 
 impl Default for SessionConfig {
@@ -43,6 +45,7 @@ impl Default for SessionConfig {
             kalman: KalmanConfig::default(),
             sobel_output: SobelOutput::Rows,
             misalignment: None,
+            link: LinkProtection::clean(),
         }
     }
 }
@@ -235,8 +238,12 @@ impl<L: Link> Session<L> {
     ) -> Result<Self, SessionError> {
         let timeout = device.answer_timeout();
         let mut driver = Driver::new(device);
+        driver.request_fec(config.link.fec);
+        driver.set_loss_limit(config.link.loss_limit);
         driver.hello(timeout)?;
-        let fabric = tuned_fabric_config(width, height, config.sobel_output);
+        let fabric = config
+            .link
+            .pack(tuned_fabric_config(width, height, config.sobel_output));
         driver.configure(&fabric, timeout)?;
         driver.enable()?;
         Ok(Self {
@@ -370,6 +377,7 @@ impl<L: Link> Session<L> {
         let mut record = FrameRecord {
             frame,
             raw_verge_deg: None,
+            raw_sigma_deg: None,
             filtered_verge_deg: None,
             filtered_sigma_deg: None,
             matches: 0,
@@ -380,6 +388,7 @@ impl<L: Link> Session<L> {
             truth_deg,
             dropped_because: None,
             misalignment: None,
+            link_loss: None,
         };
         record.dropped_because = match &outcome {
             Some(outcome) => damage_of(outcome),
@@ -402,6 +411,7 @@ impl<L: Link> Session<L> {
                 right: FrameOutcome::Delivered(right),
             }) => {
                 record.status = FrameStatus::NoEstimate;
+                record.link_loss = link_loss(&left, &right);
                 let estimating = Instant::now();
                 let estimate = self.estimator.estimate(&left.features, &right.features);
                 let estimate = estimate.map(|est| self.refit_misaligned(est, &mut record));
@@ -409,11 +419,15 @@ impl<L: Link> Session<L> {
                 match estimate {
                     Ok(est) => {
                         record.raw_verge_deg = Some(est.verge_deg);
+                        record.raw_sigma_deg = Some(est.sigma_deg);
                         record.matches = est.matches;
                         record.inliers = est.inliers;
                         record.keypoints_per_octave = est.keypoints_per_octave;
                         record.matches_per_octave = est.matches_per_octave;
-                        record.status = FrameStatus::Ok;
+                        record.status = match record.link_loss {
+                            Some(_) => FrameStatus::Salvaged,
+                            None => FrameStatus::Ok,
+                        };
                         Some(Measurement {
                             verge_deg: est.verge_deg,
                             sigma_deg: est.sigma_deg,
@@ -429,7 +443,7 @@ impl<L: Link> Session<L> {
             .step_with_encoders(timestamp_us, measurement, encoder_verge_deg)
             .map_err(|source| SessionError::Time { frame, source })?;
         self.last_timestamp_us = Some(timestamp_us);
-        if record.status == FrameStatus::Ok {
+        if record.status.has_estimate() {
             if let Some(f) = filtered {
                 record.filtered_verge_deg = Some(f.verge_deg);
                 record.filtered_sigma_deg = Some(f.sigma_deg);
@@ -607,6 +621,26 @@ impl<L: Link + FrameInput> Session<L> {
 }
 
 /// What the driver found wrong with a pair, `None` when both camera frames arrived whole.
+/// What the link cost a delivered pair, `None` when both frames arrived whole.
+fn link_loss(left: &ReceivedFrame, right: &ReceivedFrame) -> Option<LinkLoss> {
+    let lost = [&left.salvage, &right.salvage].map(|s| {
+        s.as_ref().map(|s| LinkLoss {
+            packets_lost: s.packets_lost,
+            keypoints_lost: s.keypoints_lost,
+        })
+    });
+    match lost {
+        [None, None] => None,
+        [l, r] => {
+            let (l, r) = (l.unwrap_or_default(), r.unwrap_or_default());
+            Some(LinkLoss {
+                packets_lost: l.packets_lost + r.packets_lost,
+                keypoints_lost: l.keypoints_lost + r.keypoints_lost,
+            })
+        }
+    }
+}
+
 fn damage_of(outcome: &PairOutcome) -> Option<String> {
     let damaged = |f: &FrameOutcome| match f {
         FrameOutcome::Delivered(_) => None,

@@ -79,13 +79,20 @@ pub struct RefinedPair {
 /// bilinearly. The window is a pure translation, so every sample shares one pair of
 /// fractional weights: the bounds are checked once and the loop is four loads and a blend,
 /// over four equal-length row slices so that it compiles to vector code without bounds checks.
-/// `None` when the window (plus its interpolation neighbours) leaves the plane.
+/// `None` when the window (plus its interpolation neighbours) leaves the plane or touches a
+/// lost row.
 fn sample_translated(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32]) -> Option<()> {
     let (w, h) = (p.width() as i32, p.height() as i32);
     let (x0, y0) = ((x - half as f32).floor(), (y - half as f32).floor());
     let (ix, iy) = (x0 as i32, y0 as i32);
     let side = 2 * half + 1;
     if !(x0.is_finite() && y0.is_finite()) || ix < 0 || iy < 0 || ix + side >= w || iy + side >= h {
+        return None;
+    }
+    if !p.window_valid(
+        i64::from(ix)..i64::from(ix + side + 1),
+        i64::from(iy)..i64::from(iy + side + 1),
+    ) {
         return None;
     }
     let (fx, fy) = (x - half as f32 - x0, y - half as f32 - y0);
@@ -109,6 +116,7 @@ fn sample_translated(p: &SobelPlane, x: f32, y: f32, half: i32, out: &mut [f32])
 
 /// [`sample_translated`] through `warp`: sample `(c, r)` of the window (offsets from its centre)
 /// is taken at `(x, y) + warp · (c, r)`, each sample with its own interpolation weights.
+/// `None` when the window leaves the plane or touches a lost row.
 fn sample_warped(
     p: &SobelPlane,
     x: f32,
@@ -129,6 +137,11 @@ fn sample_warped(
         || x + reach_x + 1.0 >= w
         || y + reach_y + 1.0 >= hh
     {
+        return None;
+    }
+    let cols = (x - reach_x).floor() as i64..(x + reach_x).floor() as i64 + 2;
+    let rows = (y - reach_y).floor() as i64..(y + reach_y).floor() as i64 + 2;
+    if !p.window_valid(cols, rows) {
         return None;
     }
     let (m, stride) = (p.magnitude(), p.width() as usize);
@@ -175,6 +188,13 @@ pub fn refine_pair(
     let (lx, ly) = (left[0].round() as i32, left[1].round() as i32);
     let (w, h) = (left_plane.width() as i32, left_plane.height() as i32);
     if lx - half - 1 < 0 || ly - half - 1 < 0 || lx + half + 1 >= w || ly + half + 1 >= h {
+        return None;
+    }
+    // The template and its central differences read one row beyond the window each side.
+    if !left_plane.window_valid(
+        i64::from(lx - half - 1)..i64::from(lx + half + 2),
+        i64::from(ly - half - 1)..i64::from(ly + half + 2),
+    ) {
         return None;
     }
     // Inside the plane, so the window side is small enough for any arithmetic below.
@@ -440,6 +460,7 @@ fn ncc_scan(
             && y - half >= 0
             && x + half < i64::from(p.width())
             && y + half < i64::from(p.height())
+            && p.window_valid(x - half..x + half + 1, y - half..y + half + 1)
     };
     // The right window lies inside its plane for one contiguous range of shifts.
     let lo = (-search).max(half - bx);
@@ -630,6 +651,55 @@ mod tests {
         }
         // Quantisation to u8 limits the precision; a few hundredths of a pixel remain.
         assert!(worst < 0.05, "worst error {worst} px");
+    }
+
+    /// Every pixel of an 80x60 plane valid except columns `cols` of row `row`.
+    fn losing(row: u32, cols: std::ops::Range<u32>) -> Vec<bool> {
+        (0..60u32)
+            .flat_map(|y| (0..80u32).map(move |x| (x, y)))
+            .map(|(x, y)| y != row || !cols.contains(&x))
+            .collect()
+    }
+
+    /// Every pixel of an 80x60 plane valid except row `row`.
+    fn rows_without(row: u32) -> Vec<bool> {
+        losing(row, 0..80)
+    }
+
+    #[test]
+    fn windows_touching_a_lost_row_are_rejected_on_either_side() {
+        let cfg = SubpixelConfig::default();
+        let (x, y) = (40.0f32, 30.0f32);
+        let l = plane(80, 60, 0.0, 0.0, 1.0);
+        let r = plane(80, 60, -3.37, 0.21, 0.9);
+        // The identity, and a verged head's stretch and shear (the warped template path).
+        for warp in [IDENTITY, [1.06, 0.0, 0.03, 1.02]] {
+            let refine = |l: &SobelPlane, r: &SobelPlane| {
+                refine_pair(l, r, [x, y], [x - 3.0, y], &warp, &cfg)
+            };
+            assert!(refine(&l, &r).is_some());
+            // The left template reads rows 22..=38 (window and central differences).
+            for lost in [22, 38] {
+                let damaged = l.clone().with_valid(rows_without(lost));
+                assert!(
+                    refine(&damaged, &r).is_none(),
+                    "left row {lost}, warp {warp:?}"
+                );
+            }
+            let far = l.clone().with_valid(rows_without(45));
+            assert_eq!(refine(&far, &r), refine(&l, &r));
+            let damaged = r.clone().with_valid(rows_without(30));
+            assert!(refine(&l, &damaged).is_none());
+            let guided = |r: &SobelPlane| guided_pair(&l, r, [x, y], [x - 3.0, y], 8, &warp, &cfg);
+            assert!(guided(&r).is_some());
+            assert!(guided(&r.clone().with_valid(rows_without(24))).is_none());
+            // A lost segment of a row costs only the windows that reach its columns: the
+            // left template spans columns 31..=49.
+            let beside = l.clone().with_valid(losing(30, 55..80));
+            assert_eq!(refine(&beside, &r), refine(&l, &r));
+            let inside = l.clone().with_valid(losing(30, 45..80));
+            assert!(refine(&inside, &r).is_none());
+        }
     }
 
     #[test]

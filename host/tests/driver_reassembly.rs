@@ -6,8 +6,9 @@ mod driver_fixture;
 use std::time::Duration;
 
 use driver_fixture::{frame_packets, pattern, point, FrameSpec, Sobel, Wire};
+use stereocal::descriptor::{describe, DescriptorConfig};
 use stereocal::driver::{
-    ContentError, Damage, Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame,
+    ContentError, Damage, Driver, DriverError, FrameOutcome, PairOutcome, ReceivedFrame, Salvage,
 };
 use stereocal::features::Gradients;
 use stereocal::link::{LinkError, ReplayLink};
@@ -17,6 +18,14 @@ const T: Duration = Duration::from_secs(1);
 
 fn driver(wire: &Wire) -> Driver<ReplayLink> {
     Driver::new(ReplayLink::new(wire.bytes.clone()))
+}
+
+/// A driver that salvages whatever it can: the small test frames have so few keypoints that
+/// any loss is beyond the default limit, which the salvage mechanics are tested apart from.
+fn salvaging(wire: &Wire) -> Driver<ReplayLink> {
+    let mut d = driver(wire);
+    d.set_loss_limit(1.0);
+    d
 }
 
 fn delivered(outcome: FrameOutcome) -> ReceivedFrame {
@@ -130,32 +139,187 @@ fn patches_are_matched_to_points_and_points_without_patch_are_dropped() {
     );
 }
 
+/// Packet index of octave 0's row `y` in [`frame_packets`] of a rows-mode frame.
+fn row_packet(y: usize) -> usize {
+    1 + y
+}
+
 #[test]
-fn sequence_gap_drops_the_frame_and_the_next_one_is_delivered() {
+fn a_lost_sobel_row_costs_only_the_windows_touching_it() {
     let mut wire = Wire::new();
-    let spec = FrameSpec::small(1, Camera::Left);
-    // Lose the third packet (a Sobel row).
-    let lost_seq = wire.next_seq(Source::Left) + 2;
-    wire.frame_losing(&spec, &[2]);
+    wire.frame_losing(&FrameSpec::small(1, Camera::Left), &[row_packet(1)]);
     wire.frame(&FrameSpec::small(1, Camera::Right));
-    let mut d = driver(&wire);
-    let first = d.next_frame(T).unwrap();
-    assert_eq!((first.frame_id(), first.camera()), (1, Camera::Left));
+    let mut d = salvaging(&wire);
+    let first = delivered(d.next_frame(T).unwrap());
     assert_eq!(
-        damage(first),
-        Damage::SequenceGap {
-            sender: Source::Left,
-            expected: lost_seq,
-            got: lost_seq + 1,
-            kind: PacketKind::SobelRows
+        first.salvage,
+        Some(Salvage {
+            packets_lost: 1,
+            rows_lost: vec![1, 0],
+            points_lost: Some(0),
+            patches_lost: Some(0),
+            keypoints_lost: 1,
+        })
+    );
+    let plane = first.features.plane(0).expect("octave 0 plane");
+    assert!(!plane.valid(0, 1) && plane.valid(0, 0) && plane.valid(0, 2));
+    assert_eq!(plane.get(3, 1), None);
+    let px = pattern(0, 3, 2);
+    assert_eq!(plane.get(3, 2), Some((px.magnitude, px.orientation)));
+    // Keypoint 0 sits on octave 0 row 6: its 16x16 window covers rows -2..14, row 1 with
+    // them. Keypoint 1's window lies in octave 1, which lost nothing.
+    let mut window = [(0, 0); 256];
+    assert_eq!(first.features.window(0, &mut window), 0);
+    assert!(first.features.window(1, &mut window) > 0);
+    let set = describe(&first.features, &DescriptorConfig::default());
+    assert!((0..set.len()).all(|i| set.keypoint(i) != 0));
+    let second = delivered(d.next_frame(T).unwrap());
+    assert_eq!((second.camera, second.salvage), (Camera::Right, None));
+    let s = d.stats();
+    assert_eq!(
+        (s.frames_delivered, s.frames_salvaged, s.frames_damaged),
+        (2, 1, 0)
+    );
+    assert_eq!((s.sequence_gaps, s.packets_lost), (1, 1));
+}
+
+#[test]
+fn a_lost_row_segment_costs_only_its_pixels() {
+    let mut spec = FrameSpec::small(1, Camera::Left);
+    spec.sobel = Sobel::Segments(8);
+    // Whole, the segmented frame gives the planes of the unsegmented one.
+    let mut wire = Wire::new();
+    wire.frame(&spec);
+    wire.frame(&FrameSpec::small(1, Camera::Left));
+    let mut d = driver(&wire);
+    let segmented = delivered(d.next_frame(T).unwrap());
+    let whole = delivered(d.next_frame(T).unwrap());
+    assert_eq!(segmented.salvage, None);
+    assert_eq!(segmented.features.gradients(), whole.features.gradients());
+    // Row 1's last segment (columns 24..32) of octave 0 lost: keypoint 0's window (columns
+    // -2..14) does not reach it.
+    let mut wire = Wire::new();
+    wire.frame_losing(&spec, &[1 + 4 + 3]);
+    let f = delivered(salvaging(&wire).next_frame(T).unwrap());
+    let salvage = f.salvage.expect("salvaged");
+    assert_eq!((salvage.rows_lost, salvage.keypoints_lost), (vec![1, 0], 0));
+    let plane = f.features.plane(0).expect("octave 0");
+    assert!(plane.valid(23, 1) && !plane.valid(24, 1) && !plane.valid(31, 1));
+    assert_eq!(plane.lost_pixels(), 8);
+    let mut window = [(0, 0); 256];
+    assert!(f.features.window(0, &mut window) > 0);
+}
+
+#[test]
+fn a_frame_that_lost_more_than_the_limit_is_dropped() {
+    let mut wire = Wire::new();
+    // One of octave 0's 16 rows: 6 % of its pixels, and keypoint 0's window touches it, half
+    // the frame's two keypoints.
+    for _ in 0..2 {
+        wire.frame_losing(&FrameSpec::small(1, Camera::Left), &[row_packet(1)]);
+    }
+    let mut d = driver(&wire);
+    assert_eq!(
+        damage(d.next_frame(T).unwrap()),
+        Damage::PlaneLost {
+            octave: 0,
+            lost: 32,
+            of: 512
         }
     );
-    let second = delivered(d.next_frame(T).unwrap());
-    assert_eq!(second.camera, Camera::Right);
-    let s = d.stats();
-    assert_eq!((s.frames_delivered, s.frames_damaged), (1, 1));
-    assert_eq!((s.sequence_gaps, s.packets_lost), (1, 1));
-    assert_eq!(s.damage.sequence_gap, 1);
+    d.set_loss_limit(0.1);
+    assert_eq!(
+        damage(d.next_frame(T).unwrap()),
+        Damage::Lost { lost: 1, of: 2 }
+    );
+    assert_eq!(d.stats().damage.lost, 2);
+}
+
+/// 600 points with distinct placements: octave 0's 512 pixels, then octave 1's first 88.
+fn many_points(frame_id: u32) -> FrameSpec {
+    let mut spec = FrameSpec::small(frame_id, Camera::Left);
+    spec.points = (0..600u16)
+        .map(|i| match i {
+            0..512 => point(i % 32, i / 32, 0, 0, 0),
+            _ => point((i - 512) % 16, (i - 512) / 16, 1, 0, 0),
+        })
+        .collect();
+    spec
+}
+
+#[test]
+fn a_lost_point_batch_costs_its_points_in_rows_mode() {
+    let mut wire = Wire::new();
+    let spec = many_points(5);
+    let packets = frame_packets(&spec);
+    // The second of the five point batches.
+    let batch = packets.len() - 5;
+    wire.frame_losing(&spec, &[batch]);
+    let f = delivered(salvaging(&wire).next_frame(T).unwrap());
+    let salvage = f.salvage.expect("salvaged");
+    assert_eq!(
+        (salvage.points_lost, salvage.rows_lost_total()),
+        (Some(128), 0)
+    );
+    assert_eq!(f.features.keypoints().len(), 472);
+}
+
+#[test]
+fn patches_after_a_lost_point_batch_find_their_points_by_placement() {
+    let mut wire = Wire::new();
+    let mut spec = many_points(6);
+    spec.sobel = Sobel::Patches((0..600).collect());
+    let packets = frame_packets(&spec);
+    let batch = packets.len() - 5;
+    wire.frame_losing(&spec, &[batch]);
+    let f = delivered(salvaging(&wire).next_frame(T).unwrap());
+    let salvage = f.salvage.expect("salvaged");
+    assert_eq!(
+        (salvage.points_lost, salvage.patches_lost),
+        (Some(128), Some(0))
+    );
+    assert_eq!(
+        (f.features.keypoints().len(), f.points_without_patch),
+        (472, 0)
+    );
+    // Received keypoint 128 is device point 256 at octave 0 (0, 8); each window is its own.
+    for k in [0, 127, 128, 471] {
+        let kp = f.features.keypoints()[k];
+        let (x, y) = kp.octave_position();
+        let px = pattern(kp.octave, x as i32, y as i32 + 1);
+        assert_eq!(
+            f.features.window_sample(k, 0, 1),
+            Some((px.magnitude, px.orientation)),
+            "keypoint {k}"
+        );
+    }
+}
+
+#[test]
+fn repeated_and_overtaken_packets_are_dropped() {
+    let mut wire = Wire::new();
+    wire.frame(&FrameSpec::small(2, Camera::Left));
+    let p = wire.packets.clone();
+    let mut bytes = Vec::new();
+    for (i, range) in p.iter().enumerate() {
+        match i {
+            // Row 2 comes twice; row 5 is overtaken by row 6.
+            3 => bytes.extend_from_slice(&wire.bytes[range.clone()].repeat(2)),
+            6 => {
+                bytes.extend_from_slice(&wire.bytes[range.clone()]);
+                bytes.extend_from_slice(&wire.bytes[p[5].clone()]);
+            }
+            5 => {}
+            _ => bytes.extend_from_slice(&wire.bytes[range.clone()]),
+        }
+    }
+    let mut d = Driver::new(ReplayLink::new(bytes));
+    d.set_loss_limit(1.0);
+    let f = delivered(d.next_frame(T).unwrap());
+    let salvage = f.salvage.expect("the overtaken row counts as lost");
+    assert_eq!((salvage.packets_lost, salvage.rows_lost), (1, vec![1, 0]));
+    assert!(!f.features.plane(0).is_some_and(|p| p.valid(0, 4)));
+    assert_eq!(d.stats().late_packets, 2);
 }
 
 #[test]
@@ -194,7 +358,7 @@ fn garbage_between_frames_is_skipped() {
 }
 
 #[test]
-fn corruption_inside_a_frame_damages_it() {
+fn corruption_inside_a_frame_costs_the_packet_it_hit() {
     let mut wire = Wire::new();
     let range = wire.frame(&FrameSpec::small(1, Camera::Left));
     wire.frame(&FrameSpec::small(1, Camera::Right));
@@ -203,17 +367,19 @@ fn corruption_inside_a_frame_damages_it() {
     let at = range.start + range.len() / 2;
     bytes[at] = if bytes[at] == 0x01 { 0x02 } else { 0x01 };
     let mut d = Driver::new(ReplayLink::new(bytes));
-    let first = d.next_frame(T).unwrap();
-    assert!(
-        matches!(damage(first), Damage::Undecodable { .. }),
-        "a corrupt packet damages its frame"
+    d.set_loss_limit(1.0);
+    let first = delivered(d.next_frame(T).unwrap());
+    assert_eq!(first.salvage.map(|s| s.packets_lost), Some(1));
+    assert_eq!(delivered(d.next_frame(T).unwrap()).salvage, None);
+    let s = d.stats();
+    assert_eq!(
+        (s.undecodable, s.frames_salvaged, s.frames_damaged),
+        (1, 1, 0)
     );
-    delivered(d.next_frame(T).unwrap());
-    assert_eq!(d.stats().frames_damaged, 1);
 }
 
 #[test]
-fn frame_cut_short_by_the_next_frame_start_is_damaged() {
+fn a_frame_without_its_end_closes_at_the_next_start_with_unknown_totals() {
     let mut wire = Wire::new();
     let spec = FrameSpec::small(2, Camera::Left);
     let packets = frame_packets(&spec);
@@ -224,16 +390,15 @@ fn frame_cut_short_by_the_next_frame_start_is_damaged() {
     let next_seq = wire.next_seq(Source::Left);
     wire.frame(&FrameSpec::small(3, Camera::Left));
     let mut d = driver(&wire);
-    let first = d.next_frame(T).unwrap();
-    match damage(first) {
-        Damage::Truncated { next } => {
-            assert_eq!(
-                (next.kind, next.seq, next.frame_id),
-                (PacketKind::FrameStart, next_seq, 3)
-            )
-        }
-        other => panic!("truncation expected, got {other}"),
-    }
+    let first = delivered(d.next_frame(T).unwrap());
+    let salvage = first.salvage.expect("salvaged");
+    assert!(salvage.end_lost());
+    assert_eq!((salvage.packets_lost, salvage.rows_lost_total()), (0, 0));
+    assert_eq!(first.features.keypoints().len(), 2);
+    assert_eq!(
+        wire.next_seq(Source::Left),
+        next_seq + frame_packets(&spec).len() as u16
+    );
     assert_eq!(delivered(d.next_frame(T).unwrap()).frame_id, 3);
 }
 
@@ -246,13 +411,12 @@ fn bytes_cut_off_mid_packet_damage_the_frame() {
     next.frame(&FrameSpec::small(3, Camera::Left));
     bytes.extend_from_slice(&next.bytes);
     let mut d = Driver::new(ReplayLink::new(bytes));
-    // The cut FrameEnd merges with the next FrameStart into one undecodable link frame.
-    assert!(matches!(
-        damage(d.next_frame(T).unwrap()),
-        Damage::Undecodable { .. }
-    ));
+    // The cut FrameEnd merges with the next FrameStart into one undecodable link frame: the
+    // first frame is salvaged without its end when the next frame's packets show up.
+    let first = delivered(d.next_frame(T).unwrap());
+    assert!(first.salvage.is_some_and(|s| s.end_lost()));
     // The next frame's numbering restarted at 0 (another device run); it is then missing
-    // its start and is dropped too, without the driver getting stuck.
+    // its start and is dropped, without the driver getting stuck.
     let second = d.next_frame(T).unwrap();
     assert_eq!(second.frame_id(), 3);
     assert_exhausted(&mut d);
@@ -348,9 +512,11 @@ fn a_packet_of_another_frame_damages_both() {
     }
     wire.frame(&FrameSpec::small(10, Camera::Left));
     let mut d = driver(&wire);
-    assert!(
-        matches!(damage(d.next_frame(T).unwrap()), Damage::Foreign { packet } if packet.camera == Camera::Right)
-    );
+    // Left kept one of octave 0's rows and no point: too little to salvage.
+    assert!(matches!(
+        damage(d.next_frame(T).unwrap()),
+        Damage::Lost { .. } | Damage::PlaneLost { .. }
+    ));
     let second = d.next_frame(T).unwrap();
     assert_eq!((second.frame_id(), second.camera()), (9, Camera::Right));
     assert!(matches!(
@@ -365,7 +531,8 @@ fn a_packet_of_another_frame_damages_both() {
 fn pairs_keep_a_damaged_partner_and_split_lone_frames() {
     let mut wire = Wire::new();
     wire.frame(&FrameSpec::small(1, Camera::Left));
-    wire.frame_losing(&FrameSpec::small(1, Camera::Right), &[3]);
+    let lose: Vec<usize> = (1..=8).map(row_packet).collect();
+    wire.frame_losing(&FrameSpec::small(1, Camera::Right), &lose);
     // Frame 2's right camera is lost without trace.
     wire.frame(&FrameSpec::small(2, Camera::Left));
     wire.frame(&FrameSpec::small(3, Camera::Right));

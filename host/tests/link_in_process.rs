@@ -57,6 +57,8 @@ fn config(mode: SobelOutput) -> FabricConfig {
         edge_ratio: 10,
         sobel_output: mode,
         sobel_scale: 1,
+        points_per_batch: 16,
+        row_segment: 1280,
         max_offset: 4096,
     }
 }
@@ -98,7 +100,8 @@ fn pair(config: &FabricConfig, left: &[u8], right: &[u8]) -> (ReceivedFrame, Rec
     let (left, right) = (deliver(left), deliver(right));
     assert_eq!(
         left.packets,
-        2 + summaries[0].sobel_packets + summaries[0].points.div_ceil(128)
+        2 + summaries[0].sobel_packets
+            + summaries[0].points.div_ceil(config.points_per_batch.into())
     );
     assert_eq!(driver.link().pending(), 0);
     assert!(matches!(

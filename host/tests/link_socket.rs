@@ -41,6 +41,8 @@ fn session(link: impl Link) {
         edge_ratio: 10,
         sobel_output: SobelOutput::Rows,
         sobel_scale: 1,
+        points_per_batch: 16,
+        row_segment: 1280,
         max_offset: 4096,
     };
     driver

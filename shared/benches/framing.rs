@@ -48,6 +48,7 @@ fn repr(y: usize, pixels: &[SobelPixel]) -> PacketRepr<'_> {
         octave: 0,
         scale: 1,
         row: y as u16,
+        x: 0,
         pixels: Records::Values(pixels),
     })
 }

@@ -30,6 +30,12 @@ pub struct Accumulator<const N: usize> {
     delivered: bool,
     /// Skipping the rest of an over-long frame.
     discarding: bool,
+    /// Frames are protected by [`fec`](crate::fec): each is repaired before it decodes.
+    #[cfg(feature = "fec-repair")]
+    fec: bool,
+    /// Blocks [`fec::repair`](crate::fec::repair) repaired, all frames.
+    #[cfg(feature = "fec-repair")]
+    fec_blocks_repaired: u64,
 }
 
 /// What [`Accumulator::feed`] found. `'de` borrows the accumulator, `'a` the input.
@@ -68,7 +74,31 @@ impl<const N: usize> Accumulator<N> {
             buf: Vec::new(),
             delivered: false,
             discarding: false,
+            #[cfg(feature = "fec-repair")]
+            fec: false,
+            #[cfg(feature = "fec-repair")]
+            fec_blocks_repaired: 0,
         }
+    }
+
+    /// Whether the frames that complete from now on are protected by forward error
+    /// correction (feature `fec-repair`) (`N` must then hold [`MAX_PROTECTED_LEN`](crate::MAX_PROTECTED_LEN) bytes
+    /// for every kind to fit).
+    #[cfg(feature = "fec-repair")]
+    pub fn set_fec(&mut self, on: bool) {
+        self.fec = on;
+    }
+
+    /// Whether frames are taken as protected by forward error correction.
+    #[cfg(feature = "fec-repair")]
+    pub fn fec(&self) -> bool {
+        self.fec
+    }
+
+    /// Blocks forward error correction has repaired so far.
+    #[cfg(feature = "fec-repair")]
+    pub fn fec_blocks_repaired(&self) -> u64 {
+        self.fec_blocks_repaired
     }
 
     /// Drops any partial frame (e.g. after reopening the link).
@@ -117,6 +147,22 @@ impl<const N: usize> Accumulator<N> {
                 continue;
             }
             self.delivered = true;
+            #[cfg(feature = "fec-repair")]
+            if self.fec {
+                match crate::fec::repair(&mut self.buf) {
+                    Ok(repaired) => {
+                        self.buf.truncate(repaired.body_len);
+                        self.fec_blocks_repaired += u64::from(repaired.blocks_repaired);
+                    }
+                    Err(error) => {
+                        return FeedResult::DecodeError {
+                            error,
+                            header: None,
+                            remaining: rest,
+                        }
+                    }
+                }
+            }
             // Every chunk was cut before a zero, so the frame holds none.
             return match decode_zero_free(&mut self.buf) {
                 Ok((header, packet)) => FeedResult::Success {

@@ -28,6 +28,9 @@ pub enum Error {
     DecodeTooManyRecords,
     /// A Sobel orientation had one of its two top bits set (orientations are 6-bit).
     DecodeBadOrientation,
+    /// A link frame under forward error correction had a length no body gives, or a block
+    /// with more damage than the code repairs.
+    DecodeBadFec,
     /// The output buffer is shorter than the encoded frame.
     EncodeBufferTooSmall,
     /// More records (points, pixels, log bytes) than the kind's maximum.
@@ -49,6 +52,7 @@ impl fmt::Display for Error {
             Error::DecodeBadLength => "decode: payload length does not match the packet layout",
             Error::DecodeTooManyRecords => "decode: record count above the packet kind's maximum",
             Error::DecodeBadOrientation => "decode: Sobel orientation wider than 6 bits",
+            Error::DecodeBadFec => "decode: link frame beyond what its error correction repairs",
             Error::EncodeBufferTooSmall => "encode: output buffer too small",
             Error::EncodeTooManyRecords => "encode: record count above the packet kind's maximum",
             Error::EncodeBadPatchSize => "encode: Sobel patch is not 16x16 pixels",

@@ -65,6 +65,7 @@ mod accumulator;
 mod checksum;
 mod cobs_in_place;
 mod error;
+pub mod fec;
 mod framing;
 mod geometry;
 mod le;
@@ -97,10 +98,12 @@ pub use packet::source::Source;
 pub use packet_repr::PacketRepr;
 pub use records::{Record, RecordIter, Records};
 
-/// The protocol version this crate writes: 2, whose header names the packet's source.
-pub const PROTOCOL_VERSION: u8 = 2;
+/// The protocol version this crate writes: 3, whose `SobelRows` names its first column (a row
+/// may go out in segments).
+pub const PROTOCOL_VERSION: u8 = 3;
 /// The protocol versions [`decode`] accepts; any other is [`Error::DecodeUnknownVersion`].
-/// Version 1's header has no source byte, so its fields sit elsewhere: it is not read.
+/// Version 1's header has no source byte, and version 2's `SobelRows` no first column, so
+/// their fields sit elsewhere: they are not read.
 pub const SUPPORTED_VERSIONS: &[u8] = &[PROTOCOL_VERSION];
 
 /// Payload length of `Hello`.
@@ -159,6 +162,9 @@ pub const MAX_PACKET_LEN: usize = HEADER_LEN + MAX_PAYLOAD_LEN + CRC_LEN;
 /// Largest link frame (an encoded packet: COBS bytes and delimiter); sizes every transmit buffer and
 /// every [`Accumulator`] that must receive all kinds.
 pub const MAX_ENCODED_LEN: usize = max_encoded_len(MAX_PAYLOAD_LEN);
+
+/// Largest link frame under forward error correction ([`fec`]), delimiter included.
+pub const MAX_PROTECTED_LEN: usize = fec::protected_len(MAX_ENCODED_LEN - 1) + 1;
 
 /// An accumulator that receives every packet kind.
 pub type FrameAccumulator = Accumulator<MAX_ENCODED_LEN>;

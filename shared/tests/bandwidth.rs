@@ -2,11 +2,13 @@
 //!
 //! Frame sizes are the COBS worst case ([`max_encoded_len`]), so the table is an upper bound.
 //! The scene: one 640x480 camera frame, 4 octaves (each half the size of the one before),
-//! 500 keypoints.
+//! 500 keypoints. Two packings: the registers' defaults for a clean link (16-point batches,
+//! whole rows), and the noisy-link guard (8-point batches, 64-pixel row segments, forward
+//! error correction on every link frame).
 
 use stereocal_wire::{
-    max_encoded_len, Camera, FrameEndRepr, FrameStartRepr, PacketRepr, PointBatchRepr, Records,
-    SobelPatchRepr, SobelPixel, SobelRowsRepr, MAX_POINTS, PATCH_PIXELS,
+    fec, max_encoded_len, Camera, FrameEndRepr, FrameStartRepr, PacketRepr, PointBatchRepr,
+    Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, PATCH_PIXELS,
 };
 
 const SPEC: &str = include_str!("../docs/wire-format.md");
@@ -18,92 +20,148 @@ const POINTS: usize = 500;
 const SCALES: usize = 4;
 const PAIRS_PER_SECOND: usize = 30;
 
-fn frame_len(repr: PacketRepr<'_>) -> usize {
-    max_encoded_len(repr.buffer_len())
+/// How the device packs its packets.
+#[derive(Clone, Copy)]
+struct Packing {
+    points_per_batch: usize,
+    row_segment: usize,
+    fec: bool,
+}
+
+/// OUTPUT_MODE's reset values, no parity.
+const CLEAN: Packing = Packing {
+    points_per_batch: 16,
+    row_segment: 1280,
+    fec: false,
+};
+
+/// `LinkProtection::noisy` of the host.
+const NOISY: Packing = Packing {
+    points_per_batch: 8,
+    row_segment: 64,
+    fec: true,
+};
+
+fn frame_len(repr: PacketRepr<'_>, packing: Packing) -> usize {
+    let plain = max_encoded_len(repr.buffer_len());
+    if packing.fec {
+        fec::protected_len(plain - 1) + 1
+    } else {
+        plain
+    }
 }
 
 /// FrameStart, the point batches and FrameEnd: sent in every mode.
-fn points_only() -> usize {
-    let start = frame_len(PacketRepr::FrameStart(FrameStartRepr {
-        frame_id: 0,
-        camera: Camera::Left,
-        width: WIDTH as u16,
-        height: HEIGHT as u16,
-        octaves: OCTAVES as u8,
-        timestamp_us: 0,
-    }));
-    let end = frame_len(PacketRepr::FrameEnd(FrameEndRepr {
-        frame_id: 0,
-        camera: Camera::Left,
-        point_count: 0,
-        sobel_count: 0,
-        flags: Default::default(),
-        dropped_points: 0,
-        dropped_sobel: 0,
-    }));
+fn points_only(packing: Packing) -> usize {
+    let start = frame_len(
+        PacketRepr::FrameStart(FrameStartRepr {
+            frame_id: 0,
+            camera: Camera::Left,
+            width: WIDTH as u16,
+            height: HEIGHT as u16,
+            octaves: OCTAVES as u8,
+            timestamp_us: 0,
+        }),
+        packing,
+    );
+    let end = frame_len(
+        PacketRepr::FrameEnd(FrameEndRepr {
+            frame_id: 0,
+            camera: Camera::Left,
+            point_count: 0,
+            sobel_count: 0,
+            flags: Default::default(),
+            dropped_points: 0,
+            dropped_sobel: 0,
+        }),
+        packing,
+    );
     let points = [Default::default(); POINTS];
     let batches: usize = points
-        .chunks(MAX_POINTS)
+        .chunks(packing.points_per_batch)
         .map(|batch| {
-            frame_len(PacketRepr::PointBatch(PointBatchRepr {
-                frame_id: 0,
-                camera: Camera::Left,
-                points: Records::Values(batch),
-            }))
+            frame_len(
+                PacketRepr::PointBatch(PointBatchRepr {
+                    frame_id: 0,
+                    camera: Camera::Left,
+                    points: Records::Values(batch),
+                }),
+                packing,
+            )
         })
         .sum();
     start + batches + end
 }
 
-/// One `SobelRows` packet per row of one scale of every octave.
-fn sobel_rows_one_scale() -> usize {
+/// The `SobelRows` packets of every row of one scale of every octave.
+fn sobel_rows_one_scale(packing: Packing) -> usize {
     let row = [SobelPixel::default(); WIDTH];
     (0..OCTAVES)
         .map(|octave| {
             let (width, height) = (WIDTH >> octave, HEIGHT >> octave);
-            let packet = frame_len(PacketRepr::SobelRows(SobelRowsRepr {
-                frame_id: 0,
-                camera: Camera::Left,
-                octave: octave as u8,
-                scale: 0,
-                row: 0,
-                pixels: Records::Values(&row[..width]),
-            }));
-            packet * height
+            let per_row: usize = row[..width]
+                .chunks(packing.row_segment)
+                .map(|segment| {
+                    frame_len(
+                        PacketRepr::SobelRows(SobelRowsRepr {
+                            frame_id: 0,
+                            camera: Camera::Left,
+                            octave: octave as u8,
+                            scale: 0,
+                            row: 0,
+                            x: 0,
+                            pixels: Records::Values(segment),
+                        }),
+                        packing,
+                    )
+                })
+                .sum();
+            per_row * height
         })
         .sum()
 }
 
 /// One `SobelPatch` per keypoint.
-fn sobel_patches() -> usize {
+fn sobel_patches(packing: Packing) -> usize {
     let patch = [SobelPixel::default(); PATCH_PIXELS];
     POINTS
-        * frame_len(PacketRepr::SobelPatch(SobelPatchRepr {
-            frame_id: 0,
-            camera: Camera::Left,
-            point_index: 0,
-            octave: 0,
-            scale: 0,
-            x: 0,
-            y: 0,
-            pixels: Records::Values(&patch),
-        }))
+        * frame_len(
+            PacketRepr::SobelPatch(SobelPatchRepr {
+                frame_id: 0,
+                camera: Camera::Left,
+                point_index: 0,
+                octave: 0,
+                scale: 0,
+                x: 0,
+                y: 0,
+                pixels: Records::Values(&patch),
+            }),
+            packing,
+        )
 }
 
 fn table() -> String {
     let rows = [
-        ("points only (no Sobel data)", points_only()),
+        ("points only (no Sobel data)", points_only(CLEAN)),
         (
             "16x16 patches at 500 points",
-            points_only() + sobel_patches(),
+            points_only(CLEAN) + sobel_patches(CLEAN),
         ),
         (
             "full Sobel rows, 1 scale x 4 octaves",
-            points_only() + sobel_rows_one_scale(),
+            points_only(CLEAN) + sobel_rows_one_scale(CLEAN),
         ),
         (
             "full Sobel rows, 4 scales x 4 octaves",
-            points_only() + SCALES * sobel_rows_one_scale(),
+            points_only(CLEAN) + SCALES * sobel_rows_one_scale(CLEAN),
+        ),
+        (
+            "noisy link: 16x16 patches at 500 points",
+            points_only(NOISY) + sobel_patches(NOISY),
+        ),
+        (
+            "noisy link: full Sobel rows, 1 scale x 4 octaves",
+            points_only(NOISY) + sobel_rows_one_scale(NOISY),
         ),
     ];
     let mut text = String::from(

@@ -171,7 +171,17 @@ proptest! {
 
 #[test]
 fn each_failure_has_its_error() {
-    let good = [2u8, 0x03, 0x01, 0x07, 0x00, 0x02, 0x00, 0x34, 0x12];
+    let good = [
+        PROTOCOL_VERSION,
+        0x03,
+        0x01,
+        0x07,
+        0x00,
+        0x02,
+        0x00,
+        0x34,
+        0x12,
+    ];
     let mut frame = frame_around(&good);
     let (header, repr) = decode(&mut frame).unwrap();
     assert_eq!(
@@ -179,7 +189,7 @@ fn each_failure_has_its_error() {
         (Source::Left, 7, marker(0x1234))
     );
 
-    for version in [0, 1, 3] {
+    for version in [0, 1, 2, 4] {
         let mut bad_version = good;
         bad_version[0] = version;
         assert_eq!(
@@ -245,8 +255,8 @@ fn each_failure_has_its_error() {
 /// damaged packet says nothing.
 #[test]
 fn an_intact_header_comes_with_the_error() {
-    let unknown_kind = [2u8, 0x7f, 0x02, 0x09, 0x00, 0x00, 0x00];
-    let bad_payload = [2u8, 0x03, 0x01, 0x0a, 0x00, 0x01, 0x00, 0x34];
+    let unknown_kind = [PROTOCOL_VERSION, 0x7f, 0x02, 0x09, 0x00, 0x00, 0x00];
+    let bad_payload = [PROTOCOL_VERSION, 0x03, 0x01, 0x0a, 0x00, 0x01, 0x00, 0x34];
     let mut damaged = frame_around(&unknown_kind);
     damaged[3] ^= 0x01;
     let stream = [
@@ -268,7 +278,7 @@ fn an_intact_header_comes_with_the_error() {
         window = remaining;
     }
     let header = |kind, source, seq, payload_len| Header {
-        version: 2,
+        version: PROTOCOL_VERSION,
         kind,
         source,
         seq,

@@ -109,6 +109,7 @@ fn max_frame_len_covers_the_largest_packet() {
         octave: 0xff,
         scale: 0xff,
         row: u16::MAX,
+        x: 0,
         pixels: stereocal_wire::Records::Values(&pixels),
     });
     assert_eq!(repr.buffer_len(), stereocal_wire::MAX_PAYLOAD_LEN);
@@ -138,6 +139,7 @@ fn long_nonzero_runs_encode_like_the_cobs_crate() {
             octave: 0xff,
             scale: 0xff,
             row: 0xffff,
+            x: 0,
             pixels: stereocal_wire::Records::Values(&bright[..len + 100]),
         });
         for repr in [log, rows] {

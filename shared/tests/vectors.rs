@@ -160,6 +160,7 @@ fn vectors(patch: &[SobelPixel]) -> BTreeMap<&'static str, (Source, u16, PacketR
                     octave: 3,
                     scale: 1,
                     row: 59,
+                    x: 36,
                     pixels: Records::Values(&ROW),
                 }),
             ),

@@ -9,7 +9,6 @@
 use std::time::Duration;
 
 use stereocal::driver::Driver;
-use stereocal::output::record::FrameStatus;
 use stereocal::output::summary::{Residual, RunCost, Summary};
 use stereocal::session::{tuned_fabric_config, SessionConfig, SessionError};
 use stereocal_firmware::softcore::finisher::ExitCode;
@@ -36,7 +35,7 @@ fn compare(test: &str, qemu: &QemuConfig, scenario: &Scenario) {
     let estimated = on_qemu
         .records
         .iter()
-        .filter(|r| r.status == FrameStatus::Ok)
+        .filter(|r| r.status.has_estimate())
         .count();
     eprintln!(
         "{test}: {} pairs, {} UART bytes identical to in-process, {estimated} estimates equal \

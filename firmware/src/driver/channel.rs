@@ -23,7 +23,8 @@ pub const CHANNEL_CAPABILITIES: Capabilities = Capabilities(
     Capabilities::POINTS.0
         | Capabilities::SOBEL_ROWS.0
         | Capabilities::SOBEL_PATCHES.0
-        | Capabilities::REGISTERS.0,
+        | Capabilities::REGISTERS.0
+        | Capabilities::FEC.0,
 );
 
 /// What one frame produced and lost.
@@ -47,6 +48,8 @@ struct FrameState {
     id: u32,
     mode: SobelOutput,
     sobel_scale: u8,
+    /// Most pixels per `SobelRows` packet.
+    row_segment: u16,
     points: u32,
     sobel_packets: u32,
     patches_dropped: u32,
@@ -97,6 +100,7 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
                     id: 0,
                     mode: SobelOutput::Patches,
                     sobel_scale: 0,
+                    row_segment: u16::MAX,
                     points: 0,
                     sobel_packets: 0,
                     patches_dropped: 0,
@@ -167,10 +171,17 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
         out: &mut PacketWriter<S>,
     ) -> Result<(), DriverError> {
         let answer = match *packet {
-            PacketRepr::Hello(_) => PacketRepr::Hello(HelloRepr {
-                version: PROTOCOL_VERSION,
-                capabilities: self.capabilities,
-            }),
+            PacketRepr::Hello(hello) => {
+                // The answer goes out as the link spoke so far; what follows is protected
+                // when the host asked for it.
+                let answer = PacketRepr::Hello(HelloRepr {
+                    version: PROTOCOL_VERSION,
+                    capabilities: self.capabilities,
+                });
+                out.send(&answer).map_err(DriverError::Encode)?;
+                out.set_fec(hello.capabilities.contains(Capabilities::FEC));
+                return Ok(());
+            }
             PacketRepr::RegisterWrite(w) => {
                 if self.write_register(w.addr, w.value) {
                     return Ok(());
@@ -252,11 +263,12 @@ impl<B: RegisterBus + PixelIn, const W0: usize> Driver<B, W0> {
             .ring
             .start(registers.width, registers.height, registers.octaves);
         self.output.patches.clear();
-        self.output.batch.clear();
+        self.output.batch.start(registers.points_per_batch);
         self.output.frame = FrameState {
             id: self.next_frame_id,
             mode: registers.sobel_output,
             sobel_scale: registers.sobel_scale,
+            row_segment: registers.row_segment,
             points: 0,
             sobel_packets: 0,
             patches_dropped: 0,
@@ -460,19 +472,25 @@ impl<const W0: usize> FrameOutput<W0> {
                     let Some(pixels) = self.ring.row(octave, row) else {
                         continue;
                     };
-                    send(
-                        out,
-                        &mut self.numbering,
-                        &PacketRepr::SobelRows(SobelRowsRepr {
-                            frame_id: self.frame.id,
-                            camera: self.camera,
-                            octave,
-                            scale: self.frame.sobel_scale,
-                            row,
-                            pixels: Records::Values(pixels),
-                        }),
-                    )?;
-                    self.frame.sobel_packets = self.frame.sobel_packets.saturating_add(1);
+                    // Validated at least MIN_SIDE, so never 0.
+                    let segment = usize::from(self.frame.row_segment).max(1);
+                    for (i, part) in pixels.chunks(segment).enumerate() {
+                        send(
+                            out,
+                            &mut self.numbering,
+                            &PacketRepr::SobelRows(SobelRowsRepr {
+                                frame_id: self.frame.id,
+                                camera: self.camera,
+                                octave,
+                                scale: self.frame.sobel_scale,
+                                row,
+                                // A row is at most MAX_WIDTH pixels, which fits a u16.
+                                x: (i * segment) as u16,
+                                pixels: Records::Values(part),
+                            }),
+                        )?;
+                        self.frame.sobel_packets = self.frame.sobel_packets.saturating_add(1);
+                    }
                 }
             }
             SobelOutput::Patches => {

@@ -19,15 +19,26 @@ pub fn wire_point(p: &Extremum) -> Point {
     }
 }
 
-/// Up to [`MAX_POINTS`] points waiting for their packet.
+/// Up to `limit` points (OUTPUT_MODE.POINTS_PER_BATCH, at most [`MAX_POINTS`]) waiting for
+/// their packet.
 pub struct PointBatch {
     points: Vec<Point, MAX_POINTS>,
+    limit: usize,
 }
 
 impl PointBatch {
-    /// An empty batch.
+    /// An empty batch of the wire's largest size.
     pub const fn new() -> Self {
-        Self { points: Vec::new() }
+        Self {
+            points: Vec::new(),
+            limit: MAX_POINTS,
+        }
+    }
+
+    /// Empties the batch and sets the frame's batch size, `limit` clamped to `1..=MAX_POINTS`.
+    pub fn start(&mut self, limit: u8) {
+        self.points.clear();
+        self.limit = usize::from(limit).clamp(1, MAX_POINTS);
     }
 
     /// Adds a point; `true` when the batch is now full and must be sent.
@@ -35,7 +46,7 @@ impl PointBatch {
     /// The caller sends and clears the batch on the push that fills it, so there is always
     /// room; a push onto a full batch would be refused (the point dropped) and answer `true`.
     pub fn push(&mut self, point: Point) -> bool {
-        self.points.push(point).is_err() || self.points.is_full()
+        self.points.push(point).is_err() || self.points.len() >= self.limit
     }
 
     /// The points collected.

@@ -6,7 +6,7 @@
 //! packets ([`Numbering`]) and writes them through the same writer, so the host sees a gap in
 //! any one source.
 
-use stereocal_wire::{encode, PacketRepr, Source, MAX_ENCODED_LEN};
+use stereocal_wire::{encode, fec, PacketRepr, Source, MAX_PROTECTED_LEN};
 
 use crate::driver::numbering::Numbering;
 
@@ -25,11 +25,14 @@ impl<S: ByteSink + ?Sized> ByteSink for &mut S {
     }
 }
 
-/// Encodes packets into a [`ByteSink`], numbering the control source's itself.
+/// Encodes packets into a [`ByteSink`], numbering the control source's itself, and protects
+/// each link frame by forward error correction when the host asked for it in `Hello`.
 pub struct PacketWriter<S: ByteSink> {
     sink: S,
     control: Numbering,
-    frame: [u8; MAX_ENCODED_LEN],
+    /// Room for the largest link frame with its parity.
+    frame: [u8; MAX_PROTECTED_LEN],
+    fec: bool,
 }
 
 impl<S: ByteSink> PacketWriter<S> {
@@ -38,8 +41,20 @@ impl<S: ByteSink> PacketWriter<S> {
         Self {
             sink,
             control: Numbering::new(Source::Control),
-            frame: [0; MAX_ENCODED_LEN],
+            frame: [0; MAX_PROTECTED_LEN],
+            fec: false,
         }
+    }
+
+    /// Whether the link frames written from now on carry forward error correction
+    /// ([`stereocal_wire::fec`]).
+    pub fn set_fec(&mut self, on: bool) {
+        self.fec = on;
+    }
+
+    /// Whether link frames carry forward error correction.
+    pub fn fec(&self) -> bool {
+        self.fec
     }
 
     /// Encodes `packet` as the control source's next packet and writes the frame to the sink.
@@ -48,8 +63,9 @@ impl<S: ByteSink> PacketWriter<S> {
             sink,
             control,
             frame,
+            fec,
         } = self;
-        write(sink, frame, control, packet)
+        write(sink, frame, *fec, control, packet)
     }
 
     /// Encodes `packet` as the next packet of `numbering`'s source (a camera channel's) and
@@ -59,7 +75,7 @@ impl<S: ByteSink> PacketWriter<S> {
         numbering: &mut Numbering,
         packet: &PacketRepr<'_>,
     ) -> Result<(), stereocal_wire::Error> {
-        write(&mut self.sink, &mut self.frame, numbering, packet)
+        write(&mut self.sink, &mut self.frame, self.fec, numbering, packet)
     }
 
     /// The control source's numbering.
@@ -83,15 +99,31 @@ impl<S: ByteSink> PacketWriter<S> {
     }
 }
 
-/// Encodes `packet` with `numbering`'s next number and writes it to `sink`. The number is used
-/// up only when the packet was encoded, so a refused packet leaves no gap.
+/// Encodes `packet` with `numbering`'s next number, protects it when `fec` is set, and writes
+/// it to `sink`. The number is used up only when the packet was encoded, so a refused packet
+/// leaves no gap.
 fn write<S: ByteSink>(
     sink: &mut S,
-    frame: &mut [u8; MAX_ENCODED_LEN],
+    frame: &mut [u8; MAX_PROTECTED_LEN],
+    fec: bool,
     numbering: &mut Numbering,
     packet: &PacketRepr<'_>,
 ) -> Result<(), stereocal_wire::Error> {
-    let bytes = encode(numbering.source(), numbering.next_seq(), packet, frame)?;
+    let len = encode(numbering.source(), numbering.next_seq(), packet, frame)?.len();
+    let len = if fec {
+        // The body is the frame without its delimiter; the parity goes where that was.
+        let protected = fec::protect(frame, len - 1)?;
+        let delimiter = frame
+            .get_mut(protected)
+            .ok_or(stereocal_wire::Error::EncodeBufferTooSmall)?;
+        *delimiter = stereocal_wire::DELIMITER;
+        protected + 1
+    } else {
+        len
+    };
+    let bytes = frame
+        .get(..len)
+        .ok_or(stereocal_wire::Error::EncodeBufferTooSmall)?;
     sink.write(bytes);
     numbering.advance();
     Ok(())

@@ -349,6 +349,8 @@ const SMALL: FabricConfig = FabricConfig {
     edge_ratio: 10,
     sobel_output: SobelOutput::Patches,
     sobel_scale: 1,
+    points_per_batch: 16,
+    row_segment: 1280,
     max_offset: 4096,
 };
 
@@ -664,7 +666,7 @@ fn points_too_late_for_the_ring_or_the_queue_are_counted() {
     );
     assert!(end.flags.contains(FrameEndFlags::SOBEL_FIFO_OVERFLOW));
     assert!(!end.flags.contains(FrameEndFlags::POINT_FIFO_OVERFLOW));
-    // 518 points go out in 128-point batches.
+    // 518 points go out in batches of the configured 16 (OUTPUT_MODE.POINTS_PER_BATCH).
     let batches: Vec<_> = packets
         .iter()
         .filter_map(|p| match p {
@@ -672,7 +674,9 @@ fn points_too_late_for_the_ring_or_the_queue_are_counted() {
             _ => None,
         })
         .collect();
-    assert_eq!(batches, [128, 128, 128, 128, 6]);
+    let mut expected = vec![16; 518 / 16];
+    expected.push(518 % 16);
+    assert_eq!(batches, expected);
 }
 
 #[test]
@@ -955,6 +959,8 @@ const TEXTURED: FabricConfig = FabricConfig {
     edge_ratio: 10,
     sobel_output: SobelOutput::Patches,
     sobel_scale: 1,
+    points_per_batch: 16,
+    row_segment: 1280,
     max_offset: 4096,
 };
 

@@ -22,6 +22,8 @@ module sc_regs_tb;
     wire [4:0]  edge_threshold_r;
     wire        output_mode_sobel_output;
     wire [1:0]  output_mode_sobel_scale;
+    wire [7:0]  output_mode_points_per_batch;
+    wire [10:0] output_mode_row_segment;
     reg  [15:0] point_level = 16'h0, sobel_level = 16'h0;
     reg  [31:0] point_overflows = 32'h0, sobel_overflows = 32'h0, frames = 32'h0, latency = 32'h0;
     reg  [10:0] px = 11'h0, py = 11'h0;
@@ -53,6 +55,8 @@ module sc_regs_tb;
         .edge_threshold_r(edge_threshold_r),
         .output_mode_sobel_output(output_mode_sobel_output),
         .output_mode_sobel_scale(output_mode_sobel_scale),
+        .output_mode_points_per_batch(output_mode_points_per_batch),
+        .output_mode_row_segment(output_mode_row_segment),
         .point_fifo_level_level(point_level), .sobel_fifo_level_level(sobel_level),
         .point_overflow_count_count(point_overflows),
         .sobel_overflow_count_count(sobel_overflows),
@@ -116,7 +120,7 @@ module sc_regs_tb;
         expect_read("OCTAVES reset", 8'h14, 32'd4);
         expect_read("CONTRAST reset", 8'h18, 32'h0800);
         expect_read("EDGE reset", 8'h1C, 32'd10);
-        expect_read("OUTPUT_MODE reset", 8'h20, 32'h11);
+        expect_read("OUTPUT_MODE reset", 8'h20, 32'h0500_1011);
         expect_read("MAX_OFFSET reset", 8'h50, 32'd4096);
         check("max_offset port", {16'h0, max_offset_value}, 32'd4096);
 
@@ -125,8 +129,10 @@ module sc_regs_tb;
         expect_read("WIDTH rw", 8'h0C, 32'h0500);
         check("width port", {16'h0, width_value}, 32'h0500);
         write(8'h20, 32'hFFFF_FFFF);
-        expect_read("OUTPUT_MODE reserved", 8'h20, 32'h31);
+        expect_read("OUTPUT_MODE reserved", 8'h20, 32'h07FF_FF31);
         check("sobel_scale port", {30'h0, output_mode_sobel_scale}, 32'h3);
+        check("points_per_batch port", {24'h0, output_mode_points_per_batch}, 32'hFF);
+        check("row_segment port", {21'h0, output_mode_row_segment}, 32'h7FF);
         write(8'h14, 32'h2);
         write(8'h18, 32'h0100);
         write(8'h1C, 32'h0C);

@@ -50,6 +50,8 @@ enum Effect {
     SameMatchesOtherEstimates,
     /// At most this fraction of the default's wire bytes per pair.
     WireBytesAtMost(f64),
+    /// The default's estimates to the bit, on at least this multiple of its wire bytes.
+    SameEstimatesWireBytesAtLeast(f64),
 }
 
 impl Effect {
@@ -70,6 +72,13 @@ impl Effect {
                 number(j, "wire_bytes_per_pair")
                     <= fraction * number(default, "wire_bytes_per_pair")
             }
+            Effect::SameEstimatesWireBytesAtLeast(multiple) => {
+                matches == default_matches
+                    && number(j, "median_abs_err_deg") == number(default, "median_abs_err_deg")
+                    && number(j, "max_abs_err_deg") == number(default, "max_abs_err_deg")
+                    && number(j, "wire_bytes_per_pair")
+                        >= multiple * number(default, "wire_bytes_per_pair")
+            }
         }
     }
 }
@@ -77,7 +86,7 @@ impl Effect {
 #[test]
 fn every_optional_mode_estimates_the_verge() {
     let default = eval(&[]);
-    let modes: [(&[&str], Effect, f64); 13] = [
+    let modes: [(&[&str], Effect, f64); 14] = [
         (&["--descriptor", "reduced16"], Effect::OtherMatches, 0.05),
         (&["--rotate"], Effect::OtherMatches, 0.05),
         (&["--no-cross-check"], Effect::OtherMatches, 0.05),
@@ -101,6 +110,12 @@ fn every_optional_mode_estimates_the_verge() {
             0.05,
         ),
         (&["--sobel", "patches"], Effect::WireBytesAtMost(0.6), 0.1),
+        // Parity and smaller packets change the bytes on the link, not what arrives.
+        (
+            &["--noisy-link"],
+            Effect::SameEstimatesWireBytesAtLeast(1.2),
+            0.05,
+        ),
     ];
     for (extra, effect, max_err) in modes {
         let j = eval(extra);

@@ -84,8 +84,10 @@ fn head(stream: impl TimedStream, dir: &Path, pairs: usize, close: bool) {
 struct Quirks {
     /// Pairs it had streamed to nobody when the host connected (its ids do not start at 0).
     before: usize,
-    /// A pair whose bytes it damages (one byte in the middle flipped) on the way out.
-    damage: Option<usize>,
+    /// A pair whose bytes it damages on the way out, and where: 20 bytes in a row flipped from
+    /// this fraction of the pair's bytes on (0: in the left frame's `FrameStart`), more than
+    /// error correction repairs in one block.
+    damage: Option<(usize, f64)>,
     /// Whether it sends an `Encoders` reading before each pair ([`encoder_yaws_udeg`]).
     encoders: bool,
 }
@@ -117,16 +119,18 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
             Err(_) => return,
         }
-        let mut send = |device: &mut InProcessLink, damage: bool| {
+        let mut send = |device: &mut InProcessLink, damage: Option<f64>| {
             out.clear();
             Link::take_sent(device, &mut out).unwrap();
-            if damage {
-                let middle = out.len() / 2;
-                out[middle] ^= 0x5a;
+            if let Some(at) = damage {
+                // Byte 3 is inside the first link frame, whatever its COBS code bytes.
+                let at = ((out.len() as f64 * at) as usize).max(3);
+                let end = (at + 20).min(out.len());
+                out[at..end].iter_mut().for_each(|b| *b ^= 0x5a);
             }
             stream.write_all(&out).is_ok()
         };
-        if !send(&mut device, false) {
+        if !send(&mut device, None) {
             return;
         }
         if device.enabled() && !grabbed {
@@ -145,7 +149,8 @@ fn head_with(mut stream: impl TimedStream, dir: &Path, pairs: usize, close: bool
                 device
                     .submit_pair(l, r, (i as f64 * PERIOD_US).round() as u64)
                     .unwrap();
-                if !send(&mut device, q.damage == Some(i)) {
+                let damage = q.damage.filter(|&(pair, _)| pair == i).map(|(_, at)| at);
+                if !send(&mut device, damage) {
                     return;
                 }
             }
@@ -415,7 +420,7 @@ fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
 #[test]
 fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
     let quirks = Quirks {
-        damage: Some(1),
+        damage: Some((1, 0.0)),
         ..Quirks::default()
     };
     let (live, setup) = live_on_a_tcp_head(3, true, quirks, &[]);
@@ -429,13 +434,36 @@ fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
         stderr.contains("frame 1: dropped: ") && stderr.contains("damaged"),
         "{stderr}"
     );
+    assert_eq!(statuses(&setup), ["ok", "dropped", "ok"]);
+}
+
+#[test]
+fn a_pair_that_lost_a_sobel_row_is_salvaged_and_says_what_it_lost() {
+    let quirks = Quirks {
+        damage: Some((1, 0.3)),
+        ..Quirks::default()
+    };
+    // Salvage is the noisy-link guard's: it makes a lost packet cost little.
+    let (live, setup) = live_on_a_tcp_head(3, true, quirks, &["--noisy-link"]);
+    assert!(
+        live.status.success(),
+        "{}",
+        String::from_utf8_lossy(&live.stderr)
+    );
+    assert_eq!(statuses(&setup), ["ok", "salvaged", "ok"]);
     let csv = std::fs::read_to_string(setup.out_dir().join("verge.csv")).unwrap();
-    let status: Vec<&str> = csv
-        .lines()
+    let lost: Vec<&str> = csv.lines().nth(2).unwrap().split(',').skip(10).collect();
+    assert_eq!(lost[0], "1", "{csv}");
+    assert!(lost[1].parse::<u32>().unwrap() > 0, "{csv}");
+}
+
+/// The `status` column of the live run's `verge.csv`.
+fn statuses(setup: &TcpHeadSetup) -> Vec<String> {
+    let csv = std::fs::read_to_string(setup.out_dir().join("verge.csv")).unwrap();
+    csv.lines()
         .skip(1)
-        .map(|l| l.split(',').nth(6).unwrap())
-        .collect();
-    assert_eq!(status, ["ok", "dropped", "ok"], "{csv}");
+        .map(|l| l.split(',').nth(6).unwrap().to_owned())
+        .collect()
 }
 
 #[test]

@@ -14,7 +14,9 @@
 //! error and never panic. The packets are then framed again, so every edit reaches the host
 //! as a packet that decodes as far as its fields allow (the wire crate skips its CRC check
 //! under `cfg(fuzzing)`), and the stream is played back in chunks whose size the input also
-//! picks. The empty input (no edits) replays the stream as the device sent it.
+//! picks. The empty input (no edits) replays the stream as the device sent it. The session
+//! salvages every frame it can (loss limit 1), so a dropped or corrupted packet takes the
+//! salvage paths into the estimator.
 #![no_main]
 
 use std::sync::OnceLock;
@@ -22,7 +24,7 @@ use std::time::Duration;
 
 use libfuzzer_sys::fuzz_target;
 use stereocal::calib::Calibration;
-use stereocal::link::{InProcessLink, OwnCameras, Recording, ReplayLink};
+use stereocal::link::{InProcessLink, LinkProtection, OwnCameras, Recording, ReplayLink};
 use stereocal::output::record::FrameStatus;
 use stereocal::session::{Session, SessionConfig};
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
@@ -141,12 +143,17 @@ fn check(record: &stereocal::output::record::FrameRecord, frame: usize) {
         record.filtered_sigma_deg,
     ];
     match record.status {
-        FrameStatus::Ok => {
+        FrameStatus::Ok | FrameStatus::Salvaged => {
             for value in measured {
-                let value = value.expect("an ok record carries its angles");
+                let value = value.expect("an estimated record carries its angles");
                 assert!(value.is_finite(), "{record:?}");
             }
             assert!(record.filtered_sigma_deg.unwrap() >= 0.0, "{record:?}");
+            assert_eq!(
+                record.link_loss.is_some(),
+                record.status == FrameStatus::Salvaged,
+                "{record:?}"
+            );
         }
         FrameStatus::NoEstimate => assert!(measured.iter().all(Option::is_none), "{record:?}"),
         FrameStatus::Dropped => {
@@ -172,7 +179,17 @@ fuzz_target!(|data: &[u8]| {
         _ => ReplayLink::new(stream).with_chunk(usize::from(chunk - 127) * 2),
     };
     let device = OwnCameras::new(link, Duration::from_millis(1));
-    let mut session = Session::with_device(device, reference.calib, W, H, SessionConfig::default())
+    // Every frame that can be salvaged is, so that the salvage paths (lost rows, points and
+    // patches, a lost FrameEnd) reach the estimator; the default limit would drop most of the
+    // small frames' losses.
+    let config = SessionConfig {
+        link: LinkProtection {
+            loss_limit: 1.0,
+            ..LinkProtection::clean()
+        },
+        ..SessionConfig::default()
+    };
+    let mut session = Session::with_device(device, reference.calib, W, H, config)
         .expect("the recorded handshake replays");
     let mut raw_verge_deg = Vec::new();
     for frame in 0..MAX_RECORDS {

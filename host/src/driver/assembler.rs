@@ -3,11 +3,20 @@
 //! Link-independent and synchronous, so every damage case is tested with hand-built packet
 //! sequences. One frame is assembled at a time (the device sends a camera frame's packets
 //! contiguously, control packets aside). Each wire source numbers its packets on its own, so
-//! the sequence numbers are checked per source. A frame is *damaged* when a packet of it may
-//! be missing (a gap in its channel's numbering or an undecodable frame while it is open, a
-//! `FrameStart` before its `FrameEnd`, no `FrameStart` at all) or when its contents are
-//! inconsistent; a damaged frame is consumed up to its end, reported once and dropped. The
-//! next `FrameStart` always starts afresh, which is the resynchronisation.
+//! the sequence numbers are checked per source, and a gap in the frame's channel says how
+//! many of its packets the link lost; an undecodable link frame needs no rule of its own,
+//! since the packet it was shows as a gap in its source.
+//!
+//! A frame that lost packets is *salvaged* (`salvage.rs`): delivered with what arrived, the
+//! losses counted, when its `FrameStart` arrived (only it carries the timestamp) and it lost
+//! no more than the loss limit. Its end is its `FrameEnd`, or, when that was lost, the next
+//! `FrameStart` or a packet of another frame (then its totals are unknown). A frame is
+//! *damaged* when it cannot be salvaged: no `FrameStart`, more lost than the limit, contents
+//! that contradict themselves, or a device restart in its middle; a damaged frame is consumed
+//! up to its end, reported once and dropped. The next `FrameStart` always starts afresh,
+//! which is the resynchronisation. A frame packet whose number lies just behind its source's
+//! last (a repeat, or one overtaken by a later packet) is dropped: its place was already
+//! counted as lost or filled.
 
 use std::collections::{HashMap, VecDeque};
 
@@ -18,10 +27,11 @@ use stereocal_wire::{
 };
 
 use super::damage::{ContentError, Damage, PacketRef};
-use super::gradients::{FinishError, GradientBuilder};
+use super::gradients::{Completeness, FinishError, GradientBuilder};
 use super::keypoint::keypoint;
+use super::salvage::{within_limit, Salvage, MAX_LOST_FRACTION};
 use super::stats::LinkStats;
-use crate::features::{FeatureFrame, Keypoint};
+use crate::features::{FeatureFrame, Gradients, Keypoint};
 use stereocal_wire::octave_dims;
 
 /// A camera frame that arrived complete and consistent.
@@ -48,6 +58,8 @@ pub struct ReceivedFrame {
     pub flags: FrameEndFlags,
     /// Points left out of `features` because their patch never came (patches mode).
     pub points_without_patch: u32,
+    /// What the link lost of the frame, `None` when it arrived whole.
+    pub salvage: Option<Salvage>,
 }
 
 /// A camera frame that was dropped.
@@ -136,6 +148,8 @@ struct Partial {
     damage: Option<Damage>,
     wire_bytes: u64,
     packets: u32,
+    /// Packets of the frame's channel its sequence numbers show lost while the frame was open.
+    lost_packets: u32,
     points: Vec<Point>,
     keypoints: Vec<Keypoint>,
     sobel_packets: u32,
@@ -151,6 +165,7 @@ impl Partial {
             damage: None,
             wire_bytes: 0,
             packets: 0,
+            lost_packets: 0,
             points: Vec::new(),
             keypoints: Vec::new(),
             sobel_packets: 0,
@@ -163,6 +178,21 @@ impl Partial {
     }
 }
 
+/// How far behind its source's last number a frame packet counts as a repeat or a late
+/// packet rather than a jump: more than a link reorders, and little enough that a device
+/// that restarted without its `Hello` reaching the host (numbering from 0 again) is taken
+/// as a jump after at most this many packets.
+const LATE_WINDOW: u16 = 8;
+
+/// What a packet's sequence number says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Numbering {
+    /// The next of its source, the first of it, or after a gap.
+    Fresh,
+    /// At or just behind its source's last number: a repeat or a late packet.
+    Late,
+}
+
 /// The receiving state machine.
 #[derive(Debug, Default)]
 pub(crate) struct FrameAssembler {
@@ -173,6 +203,8 @@ pub(crate) struct FrameAssembler {
     partial: Option<Partial>,
     events: VecDeque<Event>,
     pub stats: LinkStats,
+    /// The salvage limit when not [`MAX_LOST_FRACTION`](super::salvage::MAX_LOST_FRACTION).
+    pub loss_limit: Option<f64>,
 }
 
 /// The frame id and camera a frame-body packet carries.
@@ -265,17 +297,21 @@ impl FrameAssembler {
     /// An intact packet still used up a number of its source, which is checked as any
     /// packet's. One of a kind this host does not know (a newer device may add kinds within a
     /// version) is then counted and skipped without damage; one whose payload breaks its
-    /// kind's layout damages the open frame only when it comes from the frame's channel. A
-    /// damaged packet may have come from any source, so it damages the open frame.
+    /// kind's layout damages the open frame when it comes from the frame's channel. A damaged
+    /// packet costs nothing here: the gap it leaves in its source's numbering is counted
+    /// against the frame it belonged to.
     pub fn undecodable(
         &mut self,
         error: stereocal_wire::Error,
         header: Option<Header>,
         wire_len: usize,
     ) {
-        let mut ours = true;
+        let mut ours = false;
         if let Some(header) = header {
-            self.number(&header);
+            if self.number(&header) == Numbering::Late {
+                self.stats.late_packets += 1;
+                return;
+            }
             ours = self
                 .partial
                 .as_ref()
@@ -295,43 +331,45 @@ impl FrameAssembler {
         }
     }
 
-    /// A link frame longer than any packet.
+    /// A link frame longer than any packet: like any damaged packet, it shows as a gap.
     pub fn over_long(&mut self, wire_len: usize) {
         self.stats.over_long += 1;
-        let after_seq = self.last_decoded.unwrap_or(0);
         if let Some(p) = &mut self.partial {
             p.wire_bytes += wire_len as u64;
-            p.damage(Damage::OverLong { after_seq });
         }
     }
 
-    /// Checks an intact packet's sequence number against its source's last; a jump counts
-    /// as a gap and, when the open frame's channel jumped, damages the frame.
-    fn number(&mut self, header: &Header) {
+    /// Checks an intact packet's sequence number against its source's last. A jump counts as
+    /// a gap, and the packets it skipped count against the open frame when they were its
+    /// channel's; a number at or just behind the last is a late packet, which leaves the
+    /// numbering as it is.
+    fn number(&mut self, header: &Header) -> Numbering {
         let (source, seq) = (header.source, header.seq);
-        self.last_decoded = Some(seq);
-        let Some(last) = self.last_seq.insert(source, seq) else {
-            return;
+        let Some(&last) = self.last_seq.get(&source) else {
+            self.last_seq.insert(source, seq);
+            self.last_decoded = Some(seq);
+            return Numbering::Fresh;
         };
+        if last.wrapping_sub(seq) < LATE_WINDOW {
+            return Numbering::Late;
+        }
+        self.last_seq.insert(source, seq);
+        self.last_decoded = Some(seq);
         let expected = last.wrapping_add(1);
         if seq == expected {
-            return;
+            return Numbering::Fresh;
         }
+        let lost = seq.wrapping_sub(expected);
         self.stats.sequence_gaps += 1;
-        self.stats.packets_lost += u64::from(seq.wrapping_sub(expected));
-        // A gap in the frame's channel may have swallowed any of its packets.
+        self.stats.packets_lost += u64::from(lost);
         if let Some(p) = self
             .partial
             .as_mut()
             .filter(|p| Source::channel(p.camera) == source)
         {
-            p.damage(Damage::SequenceGap {
-                sender: source,
-                expected,
-                got: seq,
-                kind: header.kind,
-            });
+            p.lost_packets = p.lost_packets.saturating_add(u32::from(lost));
         }
+        Numbering::Fresh
     }
 
     /// A decoded packet; `wire_len` is the link bytes it took (delimiter and any noise
@@ -357,7 +395,19 @@ impl FrameAssembler {
             self.events.push_back(Event::Hello(*hello));
             return;
         }
-        self.number(header);
+        let late = self.number(header) == Numbering::Late;
+        let frame_packet = matches!(
+            packet,
+            PacketRepr::FrameStart(_)
+                | PacketRepr::PointBatch(_)
+                | PacketRepr::SobelRows(_)
+                | PacketRepr::SobelPatch(_)
+                | PacketRepr::FrameEnd(_)
+        );
+        if late && frame_packet {
+            self.stats.late_packets += 1;
+            return;
+        }
         match packet {
             PacketRepr::Log(log) => {
                 self.stats.log_frames += 1;
@@ -383,7 +433,7 @@ impl FrameAssembler {
                     camera: start.camera,
                 };
                 if let Some(previous) = self.partial.take() {
-                    self.close_damaged(previous, Damage::Truncated { next: this });
+                    self.close_without_end(previous, Damage::Truncated { next: this });
                 }
                 let mut fresh = Partial::new(start.frame_id, start.camera, Some(*start));
                 fresh.wire_bytes = wire_len as u64;
@@ -425,7 +475,7 @@ impl FrameAssembler {
         if belongs == Some(false) {
             // Another frame's packet: this frame lost its end, the other its start.
             if let Some(previous) = self.partial.take() {
-                self.close_damaged(previous, Damage::Foreign { packet: this });
+                self.close_without_end(previous, Damage::Foreign { packet: this });
             }
         }
         let p = self.partial.get_or_insert_with(|| {
@@ -464,8 +514,21 @@ impl FrameAssembler {
             })));
     }
 
+    /// Closes a frame whose `FrameEnd` was lost, found out by `reason` (the packet that
+    /// showed it): salvaged with unknown totals when it has its `FrameStart`.
+    fn close_without_end(&mut self, p: Partial, reason: Damage) {
+        match (p.start, &p.damage) {
+            (Some(start), None) => {
+                let seq = self.last_decoded.unwrap_or(0);
+                let lost = p.lost_packets;
+                self.finish(p, start, seq, None, Some(lost));
+            }
+            _ => self.close_damaged(p, reason),
+        }
+    }
+
     /// Closes a frame at its `FrameEnd` (sequence number `seq`).
-    fn close(&mut self, mut p: Partial, seq: u16, end: &FrameEndRepr) {
+    fn close(&mut self, p: Partial, seq: u16, end: &FrameEndRepr) {
         let (Some(start), None) = (p.start, &p.damage) else {
             let damage = p.damage.clone().unwrap_or(Damage::MissingStart {
                 first: PacketRef {
@@ -477,21 +540,52 @@ impl FrameAssembler {
             });
             return self.close_damaged(p, damage);
         };
-        let points_received = p.points.len() as u64;
-        if u64::from(end.point_count) != points_received || end.sobel_count != p.sobel_packets {
+        let points_received = p.points.len().min(u32::MAX as usize) as u32;
+        let counts_match = end.point_count == points_received && end.sobel_count == p.sobel_packets;
+        // Without a gap, counts that disagree are the device's own inconsistency; with one,
+        // the difference is what the link lost, which cannot exceed what was announced.
+        let lost_fits = end.point_count >= points_received && end.sobel_count >= p.sobel_packets;
+        if !counts_match && (p.lost_packets == 0 || !lost_fits) {
             let damage = Damage::CountMismatch {
                 seq,
                 points_announced: end.point_count,
-                points_received: points_received.min(u64::from(u32::MAX)) as u32,
+                points_received,
                 sobel_announced: end.sobel_count,
                 sobel_received: p.sobel_packets,
             };
             return self.close_damaged(p, damage);
         }
+        let lost = (p.lost_packets > 0).then_some(p.lost_packets);
+        self.finish(p, start, seq, Some(end), lost);
+    }
+
+    /// Assembles a frame that has its `FrameStart` and no damage. `end` is its `FrameEnd`
+    /// (`None` when lost), `lost` the packets lost (`None` when it arrived whole); a frame
+    /// that lost more than the loss limit is dropped.
+    fn finish(
+        &mut self,
+        mut p: Partial,
+        start: FrameStartRepr,
+        seq: u16,
+        end: Option<&FrameEndRepr>,
+        lost: Option<u32>,
+    ) {
+        let points_received = p.points.len().min(u32::MAX as usize) as u32;
+        let points_lost = end.map(|e| e.point_count - points_received);
+        let completeness = match lost {
+            None => Completeness::Intact,
+            Some(_) => Completeness::Salvaged {
+                width: start.width,
+                height: start.height,
+                octaves: start.octaves,
+                points_known: points_lost == Some(0),
+            },
+        };
         let points = std::mem::take(&mut p.points);
         let keypoints = std::mem::take(&mut p.keypoints);
         let gradients = std::mem::take(&mut p.gradients);
-        let finished = match gradients.finish(&points, keypoints) {
+        let patches_mode = matches!(gradients, GradientBuilder::Patches(_));
+        let finished = match gradients.finish(&points, keypoints, completeness) {
             Ok(f) => f,
             Err(FinishError::Content(problem)) => {
                 let packet = PacketRef {
@@ -511,6 +605,19 @@ impl FrameAssembler {
                 return self.close_damaged(p, damage);
             }
         };
+        let mut salvage = lost.map(|packets_lost| Salvage {
+            packets_lost,
+            rows_lost: finished.rows_lost.clone(),
+            points_lost,
+            patches_lost: end.map(|e| {
+                if patches_mode {
+                    e.sobel_count - p.sobel_packets
+                } else {
+                    0
+                }
+            }),
+            keypoints_lost: 0,
+        });
         let features = match FeatureFrame::new(
             u64::from(p.frame_id),
             start.timestamp_us,
@@ -529,7 +636,29 @@ impl FrameAssembler {
                 return self.close_damaged(p, damage);
             }
         };
+        if let Some(damage) = salvage
+            .as_ref()
+            .and_then(|_| plane_over_limit(&features, self.loss_limit.unwrap_or(MAX_LOST_FRACTION)))
+        {
+            return self.close_damaged(p, damage);
+        }
+        if let Some(s) = &mut salvage {
+            let on_lost_pixels = features.keypoints_on_lost_pixels().min(u32::MAX as usize) as u32;
+            s.keypoints_lost =
+                s.points_lost.unwrap_or(0) + s.patches_lost.unwrap_or(0) + on_lost_pixels;
+            // Without its `FrameEnd`, the points that arrived are all the frame is known to have.
+            let announced = end.map_or(points_received, |e| e.point_count);
+            let limit = self.loss_limit.unwrap_or(MAX_LOST_FRACTION);
+            if !within_limit(s.keypoints_lost, announced, limit) {
+                let damage = Damage::Lost {
+                    lost: s.keypoints_lost,
+                    of: announced,
+                };
+                return self.close_damaged(p, damage);
+            }
+        }
         self.stats.frames_delivered += 1;
+        self.stats.frames_salvaged += u64::from(salvage.is_some());
         self.stats.delivered_wire_bytes += p.wire_bytes;
         self.events
             .push_back(Event::Frame(FrameOutcome::Delivered(Box::new(
@@ -540,11 +669,30 @@ impl FrameAssembler {
                     octaves: start.octaves,
                     wire_bytes: p.wire_bytes,
                     packets: p.packets,
-                    dropped_points: end.dropped_points,
-                    dropped_sobel: end.dropped_sobel,
-                    flags: end.flags,
+                    dropped_points: end.map_or(0, |e| e.dropped_points),
+                    dropped_sobel: end.map_or(0, |e| e.dropped_sobel),
+                    flags: end.map_or(FrameEndFlags(0), |e| e.flags),
                     points_without_patch: finished.without_patch,
+                    salvage,
                 },
             ))));
     }
+}
+
+/// Why a salvaged frame lost too much of a Sobel plane to be delivered: an octave short of
+/// more than `limit` of its pixels (the guided search reads the planes beyond the keypoints'
+/// windows). `None` when every plane is within it.
+fn plane_over_limit(features: &FeatureFrame, limit: f64) -> Option<Damage> {
+    let Gradients::Planes(planes) = features.gradients() else {
+        return None;
+    };
+    planes.iter().find_map(|plane| {
+        let pixels = u64::from(plane.width()) * u64::from(plane.height());
+        let lost = plane.lost_pixels() as u64;
+        (lost as f64 > limit * pixels as f64).then(|| Damage::PlaneLost {
+            octave: plane.octave(),
+            lost: lost.min(u64::from(u32::MAX)) as u32,
+            of: pixels.min(u64::from(u32::MAX)) as u32,
+        })
+    })
 }

@@ -82,6 +82,8 @@ mod tests {
             edge_ratio: 12,
             sobel_output: regs::output_mode::SobelOutput::Rows,
             sobel_scale: 2,
+            points_per_batch: 16,
+            row_segment: 1280,
             max_offset: 4096,
         };
         let plan = plan(&config).unwrap();
@@ -99,9 +101,10 @@ mod tests {
             ]
         );
         assert!(plan.read_back.contains(&(regs::width::OFFSET, 320)));
+        // Rows (0), scale 2, 16 points per batch, whole rows of up to 1280 pixels.
         assert!(plan
             .read_back
-            .contains(&(regs::output_mode::OFFSET, 2 << 4)));
+            .contains(&(regs::output_mode::OFFSET, 1280 << 16 | 16 << 8 | 2 << 4)));
     }
 
     #[test]

@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use stereocal_wire::{Camera, PacketKind, Source};
+use stereocal_wire::{Camera, PacketKind};
 
 use crate::features::FeatureError;
 
@@ -34,19 +34,28 @@ impl fmt::Display for PacketRef {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum Damage {
-    /// Packets were lost: the sequence number of the frame's source jumped.
-    #[error("sequence gap in source {sender:?}: expected seq {expected}, got {got} ({kind:?})")]
-    SequenceGap {
-        /// The wire source whose numbering jumped: the frame's camera channel.
-        sender: Source,
-        /// The sequence number that should have come.
-        expected: u16,
-        /// The one that came.
-        got: u16,
-        /// The kind of the packet that came.
-        kind: PacketKind,
+    /// The link cost the frame more of its keypoints than a salvaged frame may lose
+    /// ([`MAX_LOST_FRACTION`](super::MAX_LOST_FRACTION)): points or patches that did not
+    /// arrive, and keypoints whose window touches a lost row.
+    #[error("lost {lost} of {of} keypoints")]
+    Lost {
+        /// Keypoints lost.
+        lost: u32,
+        /// Points announced (the points that arrived when the `FrameEnd` was lost).
+        of: u32,
     },
-    /// A frame on the link failed to decode (COBS, CRC, version, length, kind, fields).
+    /// The link cost an octave's Sobel plane more of its pixels than a salvaged frame may
+    /// lose ([`MAX_LOST_FRACTION`](super::MAX_LOST_FRACTION)).
+    #[error("lost {lost} of {of} Sobel pixels of octave {octave}")]
+    PlaneLost {
+        /// The octave.
+        octave: u8,
+        /// Pixels lost.
+        lost: u32,
+        /// Pixels of the octave.
+        of: u32,
+    },
+    /// An intact packet of the frame's channel whose payload breaks its kind's layout.
     #[error("undecodable packet after seq {after_seq}: {error}")]
     Undecodable {
         /// The sequence number of the last packet that decoded, of any source.
@@ -54,13 +63,8 @@ pub enum Damage {
         /// The wire crate's reason.
         error: stereocal_wire::Error,
     },
-    /// A frame on the link was longer than any packet and was skipped.
-    #[error("over-long packet after seq {after_seq} skipped")]
-    OverLong {
-        /// The sequence number of the last packet that decoded, of any source.
-        after_seq: u16,
-    },
-    /// The next frame started before this one's `FrameEnd`.
+    /// The device restarted (said `Hello`) before this frame's `FrameEnd`; also the reason
+    /// an unsalvageable frame gives when the next `FrameStart` came before its `FrameEnd`.
     #[error("cut short: {next} arrived before FrameEnd")]
     Truncated {
         /// The packet that started the next frame.
@@ -143,11 +147,15 @@ pub enum ContentError {
         /// Octave height.
         height: u16,
     },
-    /// A Sobel row of the wrong width.
-    #[error("Sobel row of {width} pixels, octave {octave} is {expected} wide")]
+    /// A Sobel row (or segment) that is empty or ends past its octave's width.
+    #[error(
+        "Sobel row segment of {width} pixels at column {x}, octave {octave} is {expected} wide"
+    )]
     RowWidth {
         /// Octave.
         octave: u8,
+        /// First column sent.
+        x: u16,
         /// Width sent.
         width: u16,
         /// Octave width.
@@ -163,13 +171,16 @@ pub enum ContentError {
         /// Octave height.
         height: u16,
     },
-    /// The same Sobel row twice.
-    #[error("Sobel row {row} of octave {octave} sent twice")]
+    /// Pixels of a Sobel row sent twice: a segment starting left of the end of the row's
+    /// last one.
+    #[error("Sobel row {row} of octave {octave} repeats pixels from column {x}")]
     DuplicateRow {
         /// Octave.
         octave: u8,
         /// Row.
         row: u16,
+        /// First column of the repeating segment.
+        x: u16,
     },
     /// Sobel rows of one octave from two different scales.
     #[error("Sobel rows of octave {octave} from scales {first} and {other}")]
@@ -244,12 +255,10 @@ pub enum ContentError {
 /// Counts of dropped frames by reason (one per [`Damage`] variant).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct DamageCounts {
-    /// Frames dropped for [`Damage::SequenceGap`].
-    pub sequence_gap: u64,
+    /// Frames dropped for [`Damage::Lost`].
+    pub lost: u64,
     /// Frames dropped for [`Damage::Undecodable`].
     pub undecodable: u64,
-    /// Frames dropped for [`Damage::OverLong`].
-    pub over_long: u64,
     /// Frames dropped for [`Damage::Truncated`].
     pub truncated: u64,
     /// Frames dropped for [`Damage::MissingStart`].
@@ -268,9 +277,8 @@ impl DamageCounts {
     /// Counts one dropped frame.
     pub fn count(&mut self, damage: &Damage) {
         let slot = match damage {
-            Damage::SequenceGap { .. } => &mut self.sequence_gap,
+            Damage::Lost { .. } | Damage::PlaneLost { .. } => &mut self.lost,
             Damage::Undecodable { .. } => &mut self.undecodable,
-            Damage::OverLong { .. } => &mut self.over_long,
             Damage::Truncated { .. } => &mut self.truncated,
             Damage::MissingStart { .. } => &mut self.missing_start,
             Damage::Foreign { .. } => &mut self.foreign,
@@ -283,9 +291,8 @@ impl DamageCounts {
 
     /// All dropped frames.
     pub fn total(&self) -> u64 {
-        self.sequence_gap
+        self.lost
             + self.undecodable
-            + self.over_long
             + self.truncated
             + self.missing_start
             + self.foreign

@@ -4,6 +4,14 @@
 //! per point, matched to its point by `point_index` (a patch may arrive before its point's
 //! `PointBatch`: the soft-core cuts a patch as soon as its rows are in, and flushes points in
 //! batches), placed on its point's octave pixel.
+//!
+//! A frame salvaged after link loss keeps the rows it got, with the missing ones marked
+//! invalid in its planes (an octave without any row gets an all-invalid plane, since the
+//! soft-core sends every row of every octave); its patches are matched to points by index
+//! while every point arrived, and by placement once a lost `PointBatch` has shifted the
+//! indices of the points after it.
+
+use std::collections::HashMap;
 
 use stereocal_wire::{
     octave_dims, Point, Record, Records, SobelPatchRepr, SobelPixel, SobelRowsRepr, PATCH_PIXELS,
@@ -30,7 +38,14 @@ pub(crate) struct PlaneBuilder {
     orientation: Vec<u8>,
     /// Every orientation code received, ORed together (for [`SobelPlane::with_codes`]).
     codes: u8,
-    have_row: Vec<bool>,
+    /// Per row, the column after the last segment received (0: none yet). Segments of a row
+    /// come left to right, so a segment starting before it repeats pixels.
+    row_end: Vec<u16>,
+    /// Per row, the pixels received.
+    row_pixels: Vec<u16>,
+    /// Column ranges `(row, from, to)` skipped between two segments of a row (lost packets).
+    gaps: Vec<(u16, u16, u16)>,
+    /// Rows received whole.
     rows: u32,
 }
 
@@ -97,6 +112,39 @@ pub(crate) struct Finished {
     pub gradients: Gradients,
     /// Points dropped because no patch came for them.
     pub without_patch: u32,
+    /// Rows missing per octave (rows mode of a salvaged frame; empty otherwise).
+    pub rows_lost: Vec<u32>,
+}
+
+/// How [`GradientBuilder::finish`] treats what is missing.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Completeness {
+    /// Nothing was lost on the link: every row must be there, and a patch's index is its
+    /// point's.
+    Intact,
+    /// Packets were lost: missing rows of the `octaves` octaves of a `width x height` frame
+    /// are marked invalid, and patches are matched by index only when `points_known` (no
+    /// point was lost), by placement otherwise.
+    Salvaged {
+        width: u16,
+        height: u16,
+        octaves: u8,
+        points_known: bool,
+    },
+}
+
+/// Where a point or patch sits: octave, column, row.
+type Placement = (u8, u16, u16);
+
+/// Each placement that occurs exactly once among `items`, with its index.
+fn unique_placements(items: impl Iterator<Item = (usize, Placement)>) -> HashMap<Placement, usize> {
+    let mut seen: HashMap<Placement, Option<usize>> = HashMap::new();
+    for (i, at) in items {
+        seen.entry(at).and_modify(|e| *e = None).or_insert(Some(i));
+    }
+    seen.into_iter()
+        .filter_map(|(at, i)| Some((at, i?)))
+        .collect()
 }
 
 impl GradientBuilder {
@@ -134,7 +182,9 @@ impl GradientBuilder {
                     magnitude: Vec::with_capacity(n),
                     orientation: Vec::with_capacity(n),
                     codes: 0,
-                    have_row: vec![false; usize::from(h)],
+                    row_end: vec![0; usize::from(h)],
+                    row_pixels: vec![0; usize::from(h)],
+                    gaps: Vec::new(),
                     rows: 0,
                 });
                 &mut planes[slot]
@@ -147,39 +197,50 @@ impl GradientBuilder {
                 other: row.scale,
             });
         }
-        if row.pixels.len() != usize::from(plane.width) {
+        let (x, n) = (usize::from(row.x), row.pixels.len());
+        if n == 0 || x + n > usize::from(plane.width) {
             return Err(ContentError::RowWidth {
                 octave: row.octave,
-                width: row.pixels.len().min(usize::from(u16::MAX)) as u16,
+                x: row.x,
+                width: n.min(usize::from(u16::MAX)) as u16,
                 expected: plane.width,
             });
         }
         let r = usize::from(row.row);
-        match plane.have_row.get_mut(r) {
-            None => {
-                return Err(ContentError::RowOutside {
-                    octave: row.octave,
-                    row: row.row,
-                    height: plane.height,
-                })
-            }
-            Some(true) => {
-                return Err(ContentError::DuplicateRow {
-                    octave: row.octave,
-                    row: row.row,
-                })
-            }
-            Some(have) => *have = true,
+        let (Some(end), Some(received)) = (plane.row_end.get_mut(r), plane.row_pixels.get_mut(r))
+        else {
+            return Err(ContentError::RowOutside {
+                octave: row.octave,
+                row: row.row,
+                height: plane.height,
+            });
+        };
+        if x < usize::from(*end) {
+            return Err(ContentError::DuplicateRow {
+                octave: row.octave,
+                row: row.row,
+                x: row.x,
+            });
         }
-        plane.rows += 1;
-        let start = r * usize::from(plane.width);
-        let end = start + usize::from(plane.width);
-        if plane.magnitude.len() < end {
+        if x > usize::from(*end) {
+            plane.gaps.push((row.row, *end, row.x));
+        }
+        // `x + n <= width`, a u16.
+        *end = (x + n) as u16;
+        *received += n as u16;
+        plane.rows += u32::from(*received == plane.width);
+        let row_start = r * usize::from(plane.width);
+        if plane.magnitude.len() < row_start + usize::from(plane.width) {
             // The next row (or one past a gap, which a later row fills): zeroing only what
             // the row is about to overwrite is cheap while it is in cache.
-            plane.magnitude.resize(end, 0);
-            plane.orientation.resize(end, 0);
+            plane
+                .magnitude
+                .resize(row_start + usize::from(plane.width), 0);
+            plane
+                .orientation
+                .resize(row_start + usize::from(plane.width), 0);
         }
+        let (start, end) = (row_start + x, row_start + x + n);
         let mag = &mut plane.magnitude[start..end];
         let ori = &mut plane.orientation[start..end];
         plane.codes |= match row.pixels {
@@ -246,41 +307,32 @@ impl GradientBuilder {
         self,
         points: &[Point],
         keypoints: Vec<Keypoint>,
+        completeness: Completeness,
     ) -> Result<Finished, FinishError> {
         match self {
             Self::Empty => Ok(Finished {
                 keypoints,
                 gradients: Gradients::Planes(Vec::new()),
                 without_patch: 0,
+                rows_lost: Vec::new(),
             }),
             Self::Rows(planes) => {
-                let mut out = Vec::with_capacity(planes.len());
-                for p in planes {
-                    if p.rows != u32::from(p.height) {
-                        return Err(FinishError::Content(ContentError::IncompletePlane {
-                            octave: p.octave,
-                            received: p.rows,
-                            rows: p.height,
-                        }));
-                    }
-                    let plane = SobelPlane::with_codes(
-                        p.octave,
-                        p.width.into(),
-                        p.height.into(),
-                        p.magnitude,
-                        p.orientation,
-                        p.codes,
-                    )
-                    .map_err(FinishError::Frame)?;
-                    out.push(plane);
-                }
+                let (gradients, rows_lost) = finish_planes(planes, completeness)?;
                 Ok(Finished {
                     keypoints,
-                    gradients: Gradients::Planes(out),
+                    gradients,
                     without_patch: 0,
+                    rows_lost,
                 })
             }
             Self::Patches(mut entries) => {
+                let points_known = match completeness {
+                    Completeness::Intact => true,
+                    Completeness::Salvaged { points_known, .. } => points_known,
+                };
+                if !points_known {
+                    return Ok(finish_by_placement(points, keypoints, entries));
+                }
                 if let Some(index) = entries.iter().skip(points.len()).position(Option::is_some) {
                     return Err(FinishError::Content(ContentError::PatchIndex {
                         index: (points.len() + index) as u16,
@@ -311,9 +363,137 @@ impl GradientBuilder {
                     keypoints: kept,
                     gradients: Gradients::Patches(patches),
                     without_patch,
+                    rows_lost: Vec::new(),
                 })
             }
         }
+    }
+}
+
+/// The planes of a rows-mode frame and the rows each octave lacks. An intact frame must have
+/// every row; a salvaged one gets its missing rows (and octaves) marked invalid.
+fn finish_planes(
+    planes: Vec<PlaneBuilder>,
+    completeness: Completeness,
+) -> Result<(Gradients, Vec<u32>), FinishError> {
+    let mut out = Vec::with_capacity(planes.len());
+    let mut rows_lost = Vec::new();
+    for p in planes {
+        let lost = u32::from(p.height) - p.rows;
+        if lost > 0 && matches!(completeness, Completeness::Intact) {
+            return Err(FinishError::Content(ContentError::IncompletePlane {
+                octave: p.octave,
+                received: p.rows,
+                rows: p.height,
+            }));
+        }
+        let (mut magnitude, mut orientation) = (p.magnitude, p.orientation);
+        let n = usize::from(p.width) * usize::from(p.height);
+        magnitude.resize(n, 0);
+        orientation.resize(n, 0);
+        let plane = SobelPlane::with_codes(
+            p.octave,
+            p.width.into(),
+            p.height.into(),
+            magnitude,
+            orientation,
+            p.codes,
+        )
+        .map_err(FinishError::Frame)?;
+        let plane = if lost > 0 {
+            plane.with_valid(valid_pixels(p.width, &p.row_end, &p.gaps))
+        } else {
+            plane
+        };
+        out.push(plane);
+        note_lost(&mut rows_lost, p.octave, lost);
+    }
+    if let Completeness::Salvaged {
+        width,
+        height,
+        octaves,
+        ..
+    } = completeness
+    {
+        let missing: Vec<u8> = (0..octaves)
+            .filter(|&o| !out.iter().any(|p| p.octave() == o))
+            .collect();
+        for octave in missing {
+            let (w, h) = octave_dims(width, height, octave);
+            let n = usize::from(w) * usize::from(h);
+            let plane =
+                SobelPlane::with_codes(octave, w.into(), h.into(), vec![0; n], vec![0; n], 0)
+                    .map_err(FinishError::Frame)?;
+            out.push(plane.with_valid(Vec::new()));
+            note_lost(&mut rows_lost, octave, u32::from(h));
+        }
+    }
+    Ok((Gradients::Planes(out), rows_lost))
+}
+
+/// The received pixels of a `width`-wide plane, row-major: each row up to `row_end`, less the
+/// `gaps` between its segments.
+fn valid_pixels(width: u16, row_end: &[u16], gaps: &[(u16, u16, u16)]) -> Vec<bool> {
+    let w = usize::from(width);
+    let mut valid = vec![false; w * row_end.len()];
+    for (r, &end) in row_end.iter().enumerate() {
+        valid[r * w..r * w + usize::from(end)].fill(true);
+    }
+    for &(r, from, to) in gaps {
+        let row = usize::from(r) * w;
+        valid[row + usize::from(from)..row + usize::from(to)].fill(false);
+    }
+    valid
+}
+
+/// Records `lost` rows of `octave` in the per-octave list.
+fn note_lost(rows_lost: &mut Vec<u32>, octave: u8, lost: u32) {
+    let i = usize::from(octave);
+    if rows_lost.len() <= i {
+        rows_lost.resize(i + 1, 0);
+    }
+    rows_lost[i] += lost;
+}
+
+/// Pairs patches with points by placement, for a frame that lost points (a patch's
+/// `point_index` counts the lost ones too). A placement shared by two points or two patches
+/// is ambiguous, and its points go without a patch.
+fn finish_by_placement(
+    points: &[Point],
+    keypoints: Vec<Keypoint>,
+    entries: Vec<Option<PatchEntry>>,
+) -> Finished {
+    let at_point = unique_placements(
+        points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (i, (p.octave, p.x, p.y))),
+    );
+    let at_patch = unique_placements(
+        entries
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| e.as_ref().map(|e| (i, (e.octave, e.x, e.y)))),
+    );
+    let mut entries = entries;
+    let mut kept = Vec::with_capacity(points.len());
+    let mut patches = Vec::with_capacity(points.len());
+    for (i, (p, k)) in points.iter().zip(keypoints).enumerate() {
+        let at = (p.octave, p.x, p.y);
+        if at_point.get(&at) != Some(&i) {
+            continue;
+        }
+        let Some(entry) = at_patch.get(&at).and_then(|&j| entries.get_mut(j)?.take()) else {
+            continue;
+        };
+        kept.push(k);
+        patches.push(entry.patch);
+    }
+    Finished {
+        without_patch: (points.len() - kept.len()) as u32,
+        keypoints: kept,
+        gradients: Gradients::Patches(patches),
+        rows_lost: Vec::new(),
     }
 }
 
@@ -342,6 +522,7 @@ mod tests {
             octave: 0,
             scale: 1,
             row,
+            x: 0,
             pixels,
         }
     }
@@ -356,7 +537,7 @@ mod tests {
             let packet = rows_packet(row, Records::Wire(&bytes));
             assert!(builder.add_row(&packet, width, height, 1).is_ok());
         }
-        let Ok(finished) = builder.finish(&[], Vec::new()) else {
+        let Ok(finished) = builder.finish(&[], Vec::new(), Completeness::Intact) else {
             panic!("complete plane refused");
         };
         let Gradients::Planes(planes) = finished.gradients else {
@@ -384,7 +565,7 @@ mod tests {
             assert!(builder.add_row(packet, width, height, 1).is_ok());
         }
         assert!(matches!(
-            builder.finish(&[], Vec::new()),
+            builder.finish(&[], Vec::new(), Completeness::Intact),
             Err(FinishError::Frame(FeatureError::OrientationRange {
                 octave: 0,
                 index: 75,

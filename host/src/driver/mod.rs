@@ -28,6 +28,7 @@ mod damage;
 mod error;
 mod gradients;
 mod keypoint;
+mod salvage;
 mod stats;
 
 use std::collections::VecDeque;
@@ -36,13 +37,15 @@ use std::time::{Duration, Instant};
 use stereocal_hdl::{FabricConfig, Registers};
 use stereocal_wire::{
     encode, Accumulator, Camera, EncodersRepr, ErrorReportRepr, FeedResult, HelloRepr, PacketRepr,
-    RegisterReadRepr, RegisterWriteRepr, Source, MAX_ENCODED_LEN, PROTOCOL_VERSION,
+    RegisterReadRepr, RegisterWriteRepr, Source, MAX_ENCODED_LEN, MAX_PROTECTED_LEN,
+    PROTOCOL_VERSION,
 };
 
 pub use assembler::{DamagedFrame, FrameOutcome, LogFrame, ReceivedFrame};
 pub use damage::{ContentError, Damage, DamageCounts, PacketRef};
 pub use error::{DriverError, Waiting};
 pub use keypoint::keypoint;
+pub use salvage::{Salvage, MAX_LOST_FRACTION};
 pub use stats::LinkStats;
 
 use crate::link::{Link, LinkError};
@@ -121,7 +124,9 @@ pub struct DeviceReport {
 /// The host driver over a link `L`.
 pub struct Driver<L: Link> {
     link: L,
-    accumulator: Box<Accumulator<{ MAX_ENCODED_LEN - 1 }>>,
+    accumulator: Box<Accumulator<{ MAX_PROTECTED_LEN - 1 }>>,
+    /// Ask the device for forward error correction in `Hello`.
+    request_fec: bool,
     rx: Vec<u8>,
     rx_pos: usize,
     rx_len: usize,
@@ -145,6 +150,7 @@ impl<L: Link> Driver<L> {
         Self {
             link,
             accumulator: Box::new(Accumulator::new()),
+            request_fec: false,
             rx: vec![0; RECEIVE_CHUNK],
             rx_pos: 0,
             rx_len: 0,
@@ -206,11 +212,39 @@ impl<L: Link> Driver<L> {
         found
     }
 
+    /// Whether the next [`Driver::hello`] asks the device to protect its link frames by
+    /// forward error correction ([`stereocal_wire::fec`]): 7.7 % more bytes on the link, and
+    /// up to 8 damaged bytes in each 255 repaired. A device that can answers with
+    /// [`Capabilities::FEC`](stereocal_wire::Capabilities::FEC) and protects every link frame
+    /// after its answer; one that cannot keeps sending plain frames, and so does the host's
+    /// side of the link.
+    pub fn request_fec(&mut self, on: bool) {
+        self.request_fec = on;
+    }
+
+    /// The largest fraction of a camera frame's keypoints the link may cost it and the frame
+    /// still be delivered (salvaged); [`MAX_LOST_FRACTION`] unless set. A larger limit
+    /// delivers more frames of a noisy link, whose estimates then stray further from what the
+    /// intact frames would give.
+    pub fn set_loss_limit(&mut self, fraction: f64) {
+        self.assembler.loss_limit = Some(fraction.clamp(0.0, 1.0));
+    }
+
+    /// Whether the device's link frames are taken as protected by forward error correction.
+    pub fn fec(&self) -> bool {
+        self.accumulator.fec()
+    }
+
     /// Sends the host's `Hello` and waits for the device's (one already received counts).
     pub fn hello(&mut self, timeout: Duration) -> Result<HelloRepr, DriverError> {
+        let fec = if self.request_fec {
+            stereocal_wire::Capabilities::FEC
+        } else {
+            stereocal_wire::Capabilities(0)
+        };
         self.send(&PacketRepr::Hello(HelloRepr {
             version: PROTOCOL_VERSION,
-            capabilities: HOST_CAPABILITIES,
+            capabilities: HOST_CAPABILITIES | fec,
         }))?;
         let deadline = Instant::now() + timeout;
         let hello = loop {
@@ -391,6 +425,7 @@ impl<L: Link> Driver<L> {
     fn decode_buffered(&mut self) -> bool {
         while self.rx_pos < self.rx_len {
             let input = &self.rx[self.rx_pos..self.rx_len];
+            let mut fec = None;
             let (rest_len, frame_len) = match self.accumulator.feed(input) {
                 FeedResult::Consumed => (0, None),
                 FeedResult::OverFull(rest) => {
@@ -413,10 +448,23 @@ impl<L: Link> Driver<L> {
                     remaining,
                 } => {
                     let wire = self.wire_pending + input.len() - remaining.len();
+                    // The device's `Hello` says whether the link frames after it are
+                    // protected: when the host asked and the device can.
+                    fec = match packet {
+                        PacketRepr::Hello(h) => Some(
+                            self.request_fec
+                                && h.capabilities.contains(stereocal_wire::Capabilities::FEC),
+                        ),
+                        _ => None,
+                    };
                     self.assembler.packet(&header, &packet, wire);
                     (remaining.len(), Some(wire))
                 }
             };
+            if let Some(on) = fec {
+                self.accumulator.set_fec(on);
+            }
+            self.assembler.stats.fec_blocks_repaired = self.accumulator.fec_blocks_repaired();
             let consumed = self.rx_len - self.rx_pos - rest_len;
             // Bytes of a link frame that is not complete yet count towards that frame.
             self.wire_pending = match frame_len {

@@ -27,8 +27,13 @@ pub struct LinkStats {
     pub packets_lost: u64,
     /// Decoded packets that belong to no frame and are no answer the driver waits for.
     pub stray_packets: u64,
-    /// Camera frames assembled and handed out.
+    /// Frame packets dropped because their number was at or just behind their source's last
+    /// (repeated or overtaken on the link).
+    pub late_packets: u64,
+    /// Camera frames assembled and handed out (salvaged ones included).
     pub frames_delivered: u64,
+    /// Delivered camera frames that had lost packets (see `ReceivedFrame::salvage`).
+    pub frames_salvaged: u64,
     /// Camera frames dropped (sum of `damage`).
     pub frames_damaged: u64,
     /// Dropped frames by reason.
@@ -41,6 +46,8 @@ pub struct LinkStats {
     pub logs_discarded: u64,
     /// `ErrorReport` packets received.
     pub device_errors: u64,
+    /// Blocks of link frames that forward error correction repaired (0 without it).
+    pub fec_blocks_repaired: u64,
 }
 
 impl LinkStats {

@@ -247,6 +247,10 @@ impl Link for InProcessLink {
                         .left
                         .handle_host_packet(&packet, &mut self.writer)
                         .map_err(|e| channel_error(Camera::Left, &e));
+                    // A `Hello` sets the link's error correction; the cameras' frames take
+                    // the same link.
+                    let fec = self.writer.fec();
+                    self.pair_out.iter_mut().for_each(|w| w.set_fec(fec));
                     (answered, remaining)
                 }
             };

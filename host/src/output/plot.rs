@@ -173,6 +173,7 @@ mod tests {
                 FrameRecord {
                     frame: i,
                     raw_verge_deg: ok.then_some(v + 0.01),
+                    raw_sigma_deg: None,
                     filtered_verge_deg: ok.then_some(v),
                     filtered_sigma_deg: ok.then_some(0.01),
                     matches: 30,
@@ -187,6 +188,7 @@ mod tests {
                     truth_deg: Some(v),
                     dropped_because: None,
                     misalignment: None,
+                    link_loss: None,
                 }
             })
             .collect();

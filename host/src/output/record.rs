@@ -12,6 +12,9 @@ use crate::misalignment::MisalignmentEstimate;
 pub enum FrameStatus {
     /// The estimator produced a verge measurement.
     Ok,
+    /// The estimator produced a verge measurement from what arrived intact of a pair that
+    /// lost packets on the link (the record's [`LinkLoss`] says how much).
+    Salvaged,
     /// The frame arrived intact but held too little geometry to measure the verge
     /// (texture-less scene, too few consistent matches).
     NoEstimate,
@@ -24,9 +27,17 @@ impl FrameStatus {
     pub fn as_str(self) -> &'static str {
         match self {
             FrameStatus::Ok => "ok",
+            FrameStatus::Salvaged => "salvaged",
             FrameStatus::NoEstimate => "no_estimate",
             FrameStatus::Dropped => "dropped",
         }
+    }
+}
+
+impl FrameStatus {
+    /// Whether the pair gave a verge measurement (`Ok` or `Salvaged`).
+    pub fn has_estimate(self) -> bool {
+        matches!(self, FrameStatus::Ok | FrameStatus::Salvaged)
     }
 }
 
@@ -41,11 +52,15 @@ impl fmt::Display for FrameStatus {
 pub struct FrameRecord {
     /// Index of the frame pair in the sequence.
     pub frame: usize,
-    /// The per-frame measurement, `None` unless `status` is `Ok`.
+    /// The per-frame measurement, `None` unless the pair has an estimate
+    /// ([`FrameStatus::has_estimate`]).
     pub raw_verge_deg: Option<f64>,
-    /// The Kalman estimate after this frame, `None` unless `status` is `Ok`.
+    /// The measurement's own 1-σ uncertainty (degrees), `None` unless the pair has an
+    /// estimate.
+    pub raw_sigma_deg: Option<f64>,
+    /// The Kalman estimate after this frame, `None` unless the pair has an estimate.
     pub filtered_verge_deg: Option<f64>,
-    /// One standard deviation of the Kalman estimate, `None` unless `status` is `Ok`.
+    /// One standard deviation of the Kalman estimate, `None` unless the pair has an estimate.
     pub filtered_sigma_deg: Option<f64>,
     /// Matches that passed the ratio test.
     pub matches: usize,
@@ -53,9 +68,10 @@ pub struct FrameRecord {
     /// (left keypoints without a descriptor match, found by correlation near their
     /// neighbours' disparity), so `inliers` can exceed `matches`.
     pub inliers: usize,
-    /// Left keypoints by octave (index 0 = full resolution), empty unless `status` is `Ok`.
+    /// Left keypoints by octave (index 0 = full resolution), empty unless the pair has an
+    /// estimate.
     pub keypoints_per_octave: Vec<usize>,
-    /// `matches` by the octave of the left keypoint, empty unless `status` is `Ok`.
+    /// `matches` by the octave of the left keypoint, empty unless the pair has an estimate.
     pub matches_per_octave: Vec<usize>,
     /// Whether the pair gave a measurement (`status` in `verge.csv`).
     pub status: FrameStatus,
@@ -66,4 +82,17 @@ pub struct FrameRecord {
     pub dropped_because: Option<String>,
     /// The misalignment window's estimate after this frame, when the session runs one.
     pub misalignment: Option<MisalignmentEstimate>,
+    /// What the link cost the pair's two frames when they were delivered salvaged; `None`
+    /// when both arrived whole (or the pair was dropped).
+    pub link_loss: Option<LinkLoss>,
+}
+
+/// What a delivered pair lost on the link, both cameras together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LinkLoss {
+    /// Packets the sequence numbers show missing.
+    pub packets_lost: u32,
+    /// Keypoints the frames could not use: points and patches lost, and keypoints whose
+    /// gradient window touches a lost pixel.
+    pub keypoints_lost: u32,
 }

@@ -34,8 +34,14 @@ pub enum Residual {
 pub struct Summary {
     /// Frame pairs in the run.
     pub frames: usize,
-    /// Pairs with status `ok`.
+    /// Pairs with an estimate (status `ok` or `salvaged`).
     pub estimated_frames: usize,
+    /// Pairs estimated from what arrived intact of frames that lost packets (`salvaged`).
+    pub salvaged_frames: usize,
+    /// Link packets the delivered pairs lost, all pairs.
+    pub packets_lost: u64,
+    /// Keypoints the delivered pairs could not use for what the link lost, all pairs.
+    pub keypoints_lost: u64,
     /// Median |raw verge − truth| in degrees, after removing `residual_removed_deg`; `None`
     /// without truth or estimates.
     pub median_abs_err_deg: Option<f64>,
@@ -78,10 +84,8 @@ pub struct RunCost {
 impl Summary {
     /// Summarise the records of one run.
     pub fn from_records(records: &[FrameRecord], residual: Residual, cost: RunCost) -> Self {
-        let estimated: Vec<&FrameRecord> = records
-            .iter()
-            .filter(|r| r.status == FrameStatus::Ok)
-            .collect();
+        let estimated: Vec<&FrameRecord> =
+            records.iter().filter(|r| r.status.has_estimate()).collect();
         let raw_pairs: Vec<(f64, f64)> = estimated
             .iter()
             .filter_map(|r| Some((r.raw_verge_deg?, r.truth_deg?)))
@@ -118,6 +122,20 @@ impl Summary {
         Summary {
             frames: records.len(),
             estimated_frames: estimated.len(),
+            salvaged_frames: records
+                .iter()
+                .filter(|r| r.status == FrameStatus::Salvaged)
+                .count(),
+            packets_lost: records
+                .iter()
+                .filter_map(|r| r.link_loss)
+                .map(|l| u64::from(l.packets_lost))
+                .sum(),
+            keypoints_lost: records
+                .iter()
+                .filter_map(|r| r.link_loss)
+                .map(|l| u64::from(l.keypoints_lost))
+                .sum(),
             median_abs_err_deg: median(&raw_err),
             p95_abs_err_deg: percentile(&raw_err, 0.95),
             max_abs_err_deg: raw_err.iter().copied().reduce(f64::max),
@@ -172,6 +190,7 @@ mod tests {
         FrameRecord {
             frame,
             raw_verge_deg: raw,
+            raw_sigma_deg: None,
             filtered_verge_deg: raw,
             filtered_sigma_deg: raw.map(|_| 0.01),
             matches: 100,
@@ -182,6 +201,7 @@ mod tests {
             truth_deg: Some(truth),
             dropped_because: None,
             misalignment: None,
+            link_loss: None,
         }
     }
 

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::output::record::FrameRecord;
 
 /// Header of `verge.csv`; part of the CLI contract, never reordered (new columns go last).
-pub const VERGE_HEADER: [&str; 10] = [
+pub const VERGE_HEADER: [&str; 12] = [
     "frame",
     "raw_verge_deg",
     "filtered_verge_deg",
@@ -18,6 +18,8 @@ pub const VERGE_HEADER: [&str; 10] = [
     "pitch_deg",
     "roll_deg",
     "baseline_tilt_deg",
+    "packets_lost",
+    "keypoints_lost",
 ];
 
 /// Header of a ground-truth file.
@@ -82,6 +84,8 @@ pub fn write_verge_csv<W: Write>(out: W, records: &[FrameRecord]) -> Result<(), 
             angle(r.misalignment.map(|m| m.pitch_deg)),
             angle(r.misalignment.map(|m| m.roll_deg)),
             angle(r.misalignment.map(|m| m.baseline_tilt_deg)),
+            r.link_loss.map_or(0, |l| l.packets_lost).to_string(),
+            r.link_loss.map_or(0, |l| l.keypoints_lost).to_string(),
         ])?;
     }
     w.flush()?;
@@ -149,7 +153,7 @@ pub fn read_truth_csv(path: &Path) -> Result<Vec<f64>, TruthError> {
 mod tests {
     use super::*;
     use crate::misalignment::MisalignmentEstimate;
-    use crate::output::record::FrameStatus;
+    use crate::output::record::{FrameStatus, LinkLoss};
 
     #[test]
     fn verge_csv_has_contract_header_and_empty_fields_without_estimate() {
@@ -157,6 +161,7 @@ mod tests {
             FrameRecord {
                 frame: 0,
                 raw_verge_deg: Some(1.25),
+                raw_sigma_deg: None,
                 filtered_verge_deg: Some(1.2),
                 filtered_sigma_deg: Some(0.01),
                 matches: 40,
@@ -175,10 +180,12 @@ mod tests {
                     baseline_tilt_sigma_deg: 0.0,
                     frames: 1,
                 }),
+                link_loss: None,
             },
             FrameRecord {
                 frame: 1,
                 raw_verge_deg: None,
+                raw_sigma_deg: None,
                 filtered_verge_deg: None,
                 filtered_sigma_deg: None,
                 matches: 2,
@@ -189,6 +196,26 @@ mod tests {
                 truth_deg: None,
                 dropped_because: None,
                 misalignment: None,
+                link_loss: None,
+            },
+            FrameRecord {
+                frame: 2,
+                raw_verge_deg: Some(1.5),
+                raw_sigma_deg: Some(0.02),
+                filtered_verge_deg: Some(1.3),
+                filtered_sigma_deg: Some(0.01),
+                matches: 30,
+                inliers: 29,
+                keypoints_per_octave: Vec::new(),
+                matches_per_octave: Vec::new(),
+                status: FrameStatus::Salvaged,
+                truth_deg: None,
+                dropped_because: None,
+                misalignment: None,
+                link_loss: Some(LinkLoss {
+                    packets_lost: 3,
+                    keypoints_lost: 7,
+                }),
             },
         ];
         let mut out = Vec::new();
@@ -197,9 +224,10 @@ mod tests {
         assert_eq!(
             text,
             "frame,raw_verge_deg,filtered_verge_deg,filtered_sigma_deg,matches,inliers,status,\
-             pitch_deg,roll_deg,baseline_tilt_deg\n\
-             0,1.250000,1.200000,0.010000,40,38,ok,0.010000,-0.030000,0.000000\n\
-             1,,,,2,0,no_estimate,,,\n"
+             pitch_deg,roll_deg,baseline_tilt_deg,packets_lost,keypoints_lost\n\
+             0,1.250000,1.200000,0.010000,40,38,ok,0.010000,-0.030000,0.000000,0,0\n\
+             1,,,,2,0,no_estimate,,,,0,0\n\
+             2,1.500000,1.300000,0.010000,30,29,salvaged,,,,3,7\n"
         );
     }
 

@@ -29,6 +29,8 @@ pub enum Sobel {
     None,
     /// Every row of every octave.
     Rows,
+    /// Every row of every octave, cut into segments of this many pixels.
+    Segments(u16),
     /// A patch for each listed point index, all before the points.
     Patches(Vec<u16>),
 }
@@ -171,7 +173,8 @@ impl Wire {
 pub enum Owned {
     Start(FrameStartRepr),
     Points(u32, Camera, Vec<Point>),
-    Row(u32, Camera, u8, u16, Vec<SobelPixel>),
+    /// Frame, camera, octave, row, first column, pixels.
+    Row(u32, Camera, u8, u16, u16, Vec<SobelPixel>),
     Patch(u32, Camera, u16, Point, Vec<SobelPixel>),
     End(FrameEndRepr),
 }
@@ -185,14 +188,17 @@ impl Owned {
                 camera: *camera,
                 points: Records::Values(points),
             }),
-            Owned::Row(id, camera, octave, row, pixels) => PacketRepr::SobelRows(SobelRowsRepr {
-                frame_id: *id,
-                camera: *camera,
-                octave: *octave,
-                scale: 1,
-                row: *row,
-                pixels: Records::Values(pixels),
-            }),
+            Owned::Row(id, camera, octave, row, x, pixels) => {
+                PacketRepr::SobelRows(SobelRowsRepr {
+                    frame_id: *id,
+                    camera: *camera,
+                    octave: *octave,
+                    scale: 1,
+                    row: *row,
+                    x: *x,
+                    pixels: Records::Values(pixels),
+                })
+            }
             Owned::Patch(id, camera, index, p, pixels) => PacketRepr::SobelPatch(SobelPatchRepr {
                 frame_id: *id,
                 camera: *camera,
@@ -222,15 +228,21 @@ pub fn frame_packets(spec: &FrameSpec) -> Vec<Owned> {
     let mut sobel_count = 0;
     match &spec.sobel {
         Sobel::None => {}
-        Sobel::Rows => {
+        Sobel::Rows | Sobel::Segments(_) => {
+            let segment = match spec.sobel {
+                Sobel::Segments(s) => s,
+                _ => u16::MAX,
+            };
             for octave in 0..spec.octaves {
                 let (w, h) = octave_dims(spec.width, spec.height, octave);
                 for y in 0..h {
-                    let row = (0..w)
-                        .map(|x| pattern(octave, i32::from(x), i32::from(y)))
-                        .collect();
-                    out.push(Owned::Row(id, cam, octave, y, row));
-                    sobel_count += 1;
+                    for x0 in (0..w).step_by(usize::from(segment)) {
+                        let row = (x0..w.min(x0.saturating_add(segment)))
+                            .map(|x| pattern(octave, i32::from(x), i32::from(y)))
+                            .collect();
+                        out.push(Owned::Row(id, cam, octave, y, x0, row));
+                        sobel_count += 1;
+                    }
                 }
             }
         }

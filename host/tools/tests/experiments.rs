@@ -2,7 +2,6 @@
 //! (thesis fig. 5.3) is built from add up to the match counts, and the experiments leave their
 //! tables and figures.
 
-use stereocal::output::record::FrameStatus;
 use stereocal::session::SessionConfig;
 use stereocal_hdl::regs::MAX_OCTAVES;
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
@@ -16,10 +15,7 @@ fn per_octave_counts_sum_to_the_matches() {
     config.trajectory = TrajectoryKind::Fixed;
     let sequence = Sequence::builtin(SceneKind::Road, config).unwrap();
     let (records, _) = evaluate(&sequence, SessionConfig::default(), &mut |_| {}).unwrap();
-    let estimated: Vec<_> = records
-        .iter()
-        .filter(|r| r.status == FrameStatus::Ok)
-        .collect();
+    let estimated: Vec<_> = records.iter().filter(|r| r.status.has_estimate()).collect();
     assert!(!estimated.is_empty());
     // Points from every octave: the coarser ones are not built for nothing.
     for octave in 1..MAX_OCTAVES as usize {

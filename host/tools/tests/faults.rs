@@ -3,8 +3,8 @@
 
 use std::time::{Duration, Instant};
 
-use stereocal::link::{FaultConfig, FaultLink, Link, LinkError, ReplayLink};
-use stereocal_tools::reliability::{judge, run, FaultKind, PairResult};
+use stereocal::link::{FaultConfig, FaultLink, Link, LinkError, LinkProtection, ReplayLink};
+use stereocal_tools::reliability::{is_wrong_estimate, judge, run, FaultKind, PairResult};
 use stereocal_tools::workload::Workload;
 
 const FRAMES: usize = 10;
@@ -14,11 +14,27 @@ const BURST: std::ops::Range<usize> = 2..7;
 #[test]
 fn heavy_faults_cost_frames_never_estimates_and_the_link_recovers() {
     let workload = Workload::road(FRAMES, 3, 320, 240).unwrap();
-    let clean = run(&workload, FaultConfig::none(3), BURST).unwrap();
+    let clean = run(
+        &workload,
+        FaultConfig::none(3),
+        BURST,
+        &LinkProtection::noisy(),
+    )
+    .unwrap();
+    // The packing and the parity change the bytes, not what arrives.
+    let plain = run(
+        &workload,
+        FaultConfig::none(3),
+        BURST,
+        &LinkProtection::clean(),
+    )
+    .unwrap();
+    assert_eq!(plain.delivered, clean.delivered);
+    assert!(plain.stats.bytes_received < clean.stats.bytes_received);
     let estimated = clean
         .delivered
         .iter()
-        .filter(|(_, r)| matches!(r, PairResult::Estimated(_)))
+        .filter(|(_, r)| matches!(r, PairResult::Estimated { .. }))
         .count();
     assert!(
         estimated >= FRAMES - 2,
@@ -32,7 +48,7 @@ fn heavy_faults_cost_frames_never_estimates_and_the_link_recovers() {
         truncate_rate: 2e-3,
         ..FaultKind::All.config(1e-4, 5)
     };
-    let faulted = run(&workload, faults, BURST).unwrap();
+    let faulted = run(&workload, faults, BURST, &LinkProtection::noisy()).unwrap();
     let v = judge(&clean, &faulted, FRAMES, &BURST);
     let f = faulted.faults;
     assert!(
@@ -49,14 +65,52 @@ fn heavy_faults_cost_frames_never_estimates_and_the_link_recovers() {
 fn a_changed_estimate_counts_as_wrong() {
     // The judge must be able to fail: tamper with one delivered result of a clean run.
     let workload = Workload::road(3, 5, 320, 240).unwrap();
-    let clean = run(&workload, FaultConfig::none(5), 0..0).unwrap();
+    let clean = run(
+        &workload,
+        FaultConfig::none(5),
+        0..0,
+        &LinkProtection::clean(),
+    )
+    .unwrap();
     let mut tampered = clean.clone();
-    tampered.delivered[1].1 = match tampered.delivered[1].1 {
-        PairResult::Estimated(bits) => PairResult::Estimated(bits ^ 1),
-        PairResult::NoEstimate => PairResult::Estimated(0),
+    let original = tampered.delivered[1].1;
+    tampered.delivered[1].1 = match original {
+        PairResult::Estimated {
+            verge_deg,
+            sigma_deg,
+            ..
+        } => PairResult::Estimated {
+            verge_deg: f64::from_bits(verge_deg.to_bits() ^ 1),
+            sigma_deg,
+            salvaged: false,
+        },
+        PairResult::NoEstimate { .. } => PairResult::Estimated {
+            verge_deg: 0.0,
+            sigma_deg: 1.0,
+            salvaged: false,
+        },
     };
     assert_eq!(judge(&clean, &clean, 3, &(0..0)).wrong, 0);
     assert_eq!(judge(&clean, &tampered, 3, &(0..0)).wrong, 1);
+    // A salvaged estimate may differ by up to its sigma, not beyond.
+    if let PairResult::Estimated {
+        verge_deg,
+        sigma_deg,
+        ..
+    } = original
+    {
+        let salvaged = |offset: f64| PairResult::Estimated {
+            verge_deg: verge_deg + offset,
+            sigma_deg,
+            salvaged: true,
+        };
+        tampered.delivered[1].1 = salvaged(0.5 * sigma_deg);
+        assert_eq!(judge(&clean, &tampered, 3, &(0..0)).wrong, 0);
+        tampered.delivered[1].1 = salvaged(1.5 * sigma_deg);
+        assert_eq!(judge(&clean, &tampered, 3, &(0..0)).wrong, 1);
+        tampered.delivered[1].1 = PairResult::NoEstimate { salvaged: true };
+        assert_eq!(judge(&clean, &tampered, 3, &(0..0)).wrong, 0);
+    }
 }
 
 /// All bytes `link` hands out until it closes.
@@ -171,8 +225,22 @@ fn a_session_over_a_damaging_link_drops_frames_and_keeps_estimates_exact() {
         .count();
     assert!(dropped > 0, "no frame of the burst was damaged");
     for (c, f) in clean.iter().zip(&faulted) {
-        if f.status == FrameStatus::Ok {
-            assert_eq!(f.raw_verge_deg, c.raw_verge_deg, "frame {}", f.frame);
+        match (f.status, f.raw_verge_deg, c.raw_verge_deg) {
+            (FrameStatus::Ok, ..) => {
+                assert_eq!(f.raw_verge_deg, c.raw_verge_deg, "frame {}", f.frame)
+            }
+            (FrameStatus::Salvaged, Some(v), Some(clean)) => {
+                let sigma = f.raw_sigma_deg.unwrap_or(f64::NAN);
+                assert!(
+                    !is_wrong_estimate(v, sigma, true, clean),
+                    "frame {}: salvaged {v} ± {sigma}, clean {clean}",
+                    f.frame
+                );
+            }
+            (FrameStatus::Salvaged, ..) => {
+                panic!("frame {}: salvaged without a clean estimate", f.frame)
+            }
+            _ => {}
         }
         if !BURST.contains(&f.frame) {
             assert_eq!(f.status, c.status, "frame {} outside the burst", f.frame);
@@ -181,7 +249,7 @@ fn a_session_over_a_damaging_link_drops_frames_and_keeps_estimates_exact() {
 }
 
 /// The soak, short: faults on every frame of a session, every estimate equal to the clean
-/// run's for the same rendered pair, the estimated frames within the accuracy bar, and the
+/// run's for the same rendered pair (within its own sigma when salvaged), the estimated frames within the accuracy bar, and the
 /// resident set sampled where it was asked for.
 #[test]
 fn a_short_soak_keeps_estimates_exact_and_samples_memory() {
@@ -200,19 +268,19 @@ fn a_short_soak_keeps_estimates_exact_and_samples_memory() {
     let s = soak(config, &|_| {}).unwrap();
     assert_eq!(s.frames, 60);
     assert_eq!(s.delivered + s.dropped, 60, "{s:?}");
-    assert!(s.dropped > 0, "no frame was damaged: {s:?}");
+    // Damaged frames are salvaged (or dropped) on the noisy-link guard the soak runs.
+    assert!(s.salvaged + s.dropped > 0, "no frame was damaged: {s:?}");
     assert!(s.estimated > 0, "no frame was estimated: {s:?}");
     assert_eq!(s.wrong, 0, "{s:?}");
     // Six rendered pairs are too few for the soak's own median to be a statistic (which pairs
-    // the faults happen to drop decides it): every delivered estimate equals the clean run's
-    // for its pair (`wrong == 0`), so the bar is checked on the clean run over the six pairs
-    // and the soak's worst error cannot exceed the clean worst.
+    // the faults happen to drop or salvage decides it): every delivered estimate equals the
+    // clean run's for its pair, or lies within its own sigma of it when salvaged
+    // (`wrong == 0`), so the bar is checked on the clean run over the six pairs.
     let clean = s.clean_median_deg.unwrap();
     assert!(
         clean <= MEDIAN_BAR_DEG,
         "clean median raw error {clean}°: {s:?}"
     );
-    assert!(s.max_deg <= s.clean_max_deg, "{s:?}");
     // Memory plumbing (flatness is judged on the long soak: this test shares its process
     // with the others).
     if std::path::Path::new("/proc/self/status").exists() {

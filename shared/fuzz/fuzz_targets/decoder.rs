@@ -1,5 +1,6 @@
 //! Arbitrary bytes into the receiving side: the streaming accumulator (at two buffer sizes and
-//! a data-dependent chunking) and `decode` on the whole input. Nothing may panic, every
+//! a data-dependent chunking, and with forward error correction on) and `decode` and
+//! `fec::repair` on the whole input. Nothing may panic, every
 //! packet that decodes must survive encode → decode unchanged, and after the input, whatever
 //! state it left the accumulator in, one `0x00` and a valid frame must give exactly that frame
 //! (resynchronisation at the next delimiter).
@@ -9,8 +10,8 @@
 
 use libfuzzer_sys::fuzz_target;
 use stereocal_wire::{
-    decode, encode, Accumulator, FeedResult, PacketRepr, RegisterReadRepr, Source, DELIMITER,
-    MAX_ENCODED_LEN,
+    decode, encode, fec, Accumulator, FeedResult, PacketRepr, RegisterReadRepr, Source,
+    DELIMITER, MAX_ENCODED_LEN, MAX_PROTECTED_LEN,
 };
 
 const MARKER_SEQ: u16 = 0xBEEF;
@@ -76,6 +77,32 @@ fuzz_target!(|data: &[u8]| {
     feed_all(&mut small, head);
     feed_all(&mut small, tail);
     resyncs(&mut small, marker_frame);
+
+    // The same input on a link under forward error correction, and the marker protected.
+    let mut protected_buf = [0u8; MAX_PROTECTED_LEN];
+    let len = encode(Source::Control, MARKER_SEQ, &MARKER, &mut protected_buf)
+        .expect("the marker encodes")
+        .len();
+    let total = fec::protect(&mut protected_buf, len - 1).expect("the marker protects");
+    protected_buf[total] = DELIMITER;
+    let mut fec_on = Accumulator::<MAX_PROTECTED_LEN>::new();
+    fec_on.set_fec(true);
+    feed_all(&mut fec_on, head);
+    feed_all(&mut fec_on, tail);
+    resyncs(&mut fec_on, &protected_buf[..=total]);
+
+    // A repaired frame's body protects to a frame that repairs to it again.
+    let mut frame = data.to_vec();
+    if let Ok(repaired) = fec::repair(&mut frame) {
+        let body = frame[..repaired.body_len].to_vec();
+        let mut again = body.clone();
+        again.resize(fec::protected_len(body.len()), 0);
+        if fec::protect(&mut again, body.len()).is_ok() {
+            let twice = fec::repair(&mut again).expect("a protected body repairs");
+            assert_eq!(twice.blocks_repaired, 0);
+            assert_eq!(&again[..twice.body_len], &body[..]);
+        }
+    }
 
     let _ = decode(&mut data.to_vec());
 });

@@ -74,6 +74,10 @@ impl Capabilities {
     pub const LOG: Capabilities = Capabilities(1 << 3);
     /// Accepts `RegisterWrite` / `RegisterRead`.
     pub const REGISTERS: Capabilities = Capabilities(1 << 4);
+    /// Forward error correction of the device's link frames ([`fec`](crate::fec)). A device
+    /// sets it when it can protect its frames; a host sets it to ask for that, and the device
+    /// protects every link frame after its `Hello` answer.
+    pub const FEC: Capabilities = Capabilities(1 << 5);
 
     /// `true` when every bit of `other` is set in `self`.
     pub const fn contains(self, other: Capabilities) -> bool {

@@ -1,15 +1,19 @@
-//! `SobelRows` (`0x12`), device to host: one full row of one scale's Sobel output.
+//! `SobelRows` (`0x12`), device to host: one row of one scale's Sobel output, or a segment of
+//! one.
 //!
 //! ```text
-//!  0          4        5        6        7          9          11                 11+2*width
-//! +----------+--------+--------+--------+----------+----------+------- ... -------+
-//! | frame_id | camera | octave | scale  |   row    |  width   | width Sobel pixels|
-//! |  u32 LE  |   u8   |   u8   |   u8   |  u16 LE  |  u16 LE  | 2 bytes each      |
-//! +----------+--------+--------+--------+----------+----------+------- ... -------+
+//!  0          4        5        6        7          9          11         13                 13+2*width
+//! +----------+--------+--------+--------+----------+----------+----------+------- ... -------+
+//! | frame_id | camera | octave | scale  |   row    |    x     |  width   | width Sobel pixels|
+//! |  u32 LE  |   u8   |   u8   |   u8   |  u16 LE  |  u16 LE  |  u16 LE  | 2 bytes each      |
+//! +----------+--------+--------+--------+----------+----------+----------+------- ... -------+
 //! ```
-//! `row` and `width` are in the octave's own pixels; pixels run left to right, each a
-//! [`SobelPixel`] (magnitude, then 6-bit orientation). A packet carries one row of up to
-//! [`MAX_WIDTH`] pixels, so a full 1280-pixel octave-0 row fits.
+//! `row`, `x` and `width` are in the octave's own pixels: the packet carries pixels
+//! `x .. x + width` of the row, left to right, each a [`SobelPixel`] (magnitude, then 6-bit
+//! orientation). A row goes out whole (`x` = 0) or cut into segments of the width
+//! OUTPUT_MODE.ROW_SEGMENT sets, so that a damaged packet costs only the part of the row it
+//! carried. `x + width` is at most [`MAX_WIDTH`], so a full 1280-pixel octave-0 row fits one
+//! packet.
 
 use crate::le::{self, Field};
 use crate::packet::camera::Camera;
@@ -25,11 +29,12 @@ mod field {
     pub const OCTAVE: usize = 5;
     pub const SCALE: usize = 6;
     pub const ROW: Field = 7..9;
-    pub const WIDTH: Field = 9..11;
-    pub const PIXELS: usize = 11;
+    pub const X: Field = 9..11;
+    pub const WIDTH: Field = 11..13;
+    pub const PIXELS: usize = 13;
 }
 
-/// Widest row one packet carries, in pixels.
+/// Widest row one packet carries, in pixels, and the end of the widest row.
 pub const MAX_WIDTH: usize = 1280;
 /// Bytes before the pixels.
 pub const HEADER_LEN: usize = field::PIXELS;
@@ -42,14 +47,14 @@ packet_view! {
 
 impl<T: AsRef<[u8]>> Packet<T> {
     /// Checks that the buffer holds the fixed fields and exactly `width` pixels, and that
-    /// `width` is at most [`MAX_WIDTH`].
+    /// `x + width` is at most [`MAX_WIDTH`].
     pub fn check_len(&self) -> Result<(), Error> {
         let len = self.buffer.as_ref().len();
         if len < HEADER_LEN {
             return Err(Error::DecodeUnexpectedEnd);
         }
         let width = usize::from(self.width());
-        if width > MAX_WIDTH {
+        if usize::from(self.x()) + width > MAX_WIDTH {
             return Err(Error::DecodeTooManyRecords);
         }
         super::check_fixed_len(len, HEADER_LEN + width * SobelPixel::LEN)
@@ -80,7 +85,12 @@ impl<T: AsRef<[u8]>> Packet<T> {
         le::read_u16(self.buffer.as_ref(), field::ROW)
     }
 
-    /// Pixels in the row.
+    /// Column of the first pixel.
+    pub fn x(&self) -> u16 {
+        le::read_u16(self.buffer.as_ref(), field::X)
+    }
+
+    /// Pixels in the packet.
     pub fn width(&self) -> u16 {
         le::read_u16(self.buffer.as_ref(), field::WIDTH)
     }
@@ -117,6 +127,11 @@ impl<T: AsRef<[u8]> + AsMut<[u8]>> Packet<T> {
         le::write_u16(self.buffer.as_mut(), field::ROW, value);
     }
 
+    /// Sets the first pixel's column.
+    pub fn set_x(&mut self, value: u16) {
+        le::write_u16(self.buffer.as_mut(), field::X, value);
+    }
+
     /// Sets the width.
     pub fn set_width(&mut self, value: u16) {
         le::write_u16(self.buffer.as_mut(), field::WIDTH, value);
@@ -142,7 +157,9 @@ pub struct SobelRowsRepr<'a> {
     pub scale: u8,
     /// Row number in the octave's image.
     pub row: u16,
-    /// The row's pixels, left to right; the width is their count.
+    /// Column of the first pixel (0 for a whole row).
+    pub x: u16,
+    /// The pixels from column `x` on, left to right; the width is their count.
     pub pixels: Records<'a, SobelPixel>,
 }
 
@@ -163,6 +180,7 @@ impl<'a> SobelRowsRepr<'a> {
             octave: packet.octave(),
             scale: packet.scale(),
             row: packet.row(),
+            x: packet.x(),
             pixels: Records::Wire(pixels),
         })
     }
@@ -175,7 +193,7 @@ impl<'a> SobelRowsRepr<'a> {
     /// Writes the payload into `packet`.
     pub fn emit<T: AsRef<[u8]> + AsMut<[u8]>>(&self, packet: &mut Packet<T>) -> Result<(), Error> {
         let width = self.pixels.len();
-        if width > MAX_WIDTH {
+        if usize::from(self.x) + width > MAX_WIDTH {
             return Err(Error::EncodeTooManyRecords);
         }
         if !all_records_valid(&self.pixels) {
@@ -187,6 +205,7 @@ impl<'a> SobelRowsRepr<'a> {
         packet.set_octave(self.octave);
         packet.set_scale(self.scale);
         packet.set_row(self.row);
+        packet.set_x(self.x);
         // `width <= MAX_WIDTH`, which fits a u16.
         packet.set_width(width as u16);
         self.pixels.write(packet.pixels_mut());
@@ -198,12 +217,13 @@ impl<'a> SobelRowsRepr<'a> {
 mod tests {
     use super::*;
 
-    static PACKET_BYTES: [u8; 17] = [
+    static PACKET_BYTES: [u8; 19] = [
         0x07, 0x00, 0x00, 0x00, // frame_id 7
         0x01, // camera Right
         0x02, // octave 2
         0x01, // scale 1
         0x77, 0x00, // row 119
+        0x05, 0x00, // x 5
         0x03, 0x00, // width 3
         0x00, 0x00, // pixel 0: magnitude 0, orientation 0
         0x80, 0x10, // pixel 1: magnitude 128, orientation 16 (90 degrees)
@@ -232,6 +252,7 @@ mod tests {
             octave: 2,
             scale: 1,
             row: 119,
+            x: 5,
             pixels: Records::Values(&PIXELS),
         }
     }
@@ -244,19 +265,21 @@ mod tests {
         assert_eq!(packet.octave(), 2);
         assert_eq!(packet.scale(), 1);
         assert_eq!(packet.row(), 119);
+        assert_eq!(packet.x(), 5);
         assert_eq!(packet.width(), 3);
-        assert_eq!(packet.pixels(), &PACKET_BYTES[11..]);
+        assert_eq!(packet.pixels(), &PACKET_BYTES[13..]);
     }
 
     #[test]
     fn construct() {
-        let mut bytes = [0xa5u8; 17];
+        let mut bytes = [0xa5u8; 19];
         let mut packet = Packet::new_unchecked(&mut bytes[..]);
         packet.set_frame_id(7);
         packet.set_camera(Camera::Right);
         packet.set_octave(2);
         packet.set_scale(1);
         packet.set_row(119);
+        packet.set_x(5);
         packet.set_width(3);
         packet
             .pixels_mut()
@@ -272,7 +295,7 @@ mod tests {
 
     #[test]
     fn emit() {
-        let mut bytes = [0u8; 17];
+        let mut bytes = [0u8; 19];
         repr()
             .emit(&mut Packet::new_unchecked(&mut bytes[..]))
             .unwrap();
@@ -283,7 +306,7 @@ mod tests {
     fn orientation_top_bits_are_rejected() {
         for bad in [0x40u8, 0x80, 0xc0] {
             let mut bytes = PACKET_BYTES;
-            bytes[16] = 0x3f | bad;
+            bytes[18] = 0x3f | bad;
             let packet = Packet::new_checked(&bytes[..]).unwrap();
             assert_eq!(
                 SobelRowsRepr::parse(&packet),
@@ -298,7 +321,7 @@ mod tests {
             pixels: Records::Values(&bad),
             ..repr()
         };
-        let mut out = [0u8; 13];
+        let mut out = [0u8; 15];
         assert_eq!(
             repr.emit(&mut Packet::new_unchecked(&mut out[..])),
             Err(Error::EncodeBadOrientation)
@@ -309,6 +332,7 @@ mod tests {
     fn full_hd_row_fits() {
         let row = [SobelPixel::default(); 1280];
         let repr = SobelRowsRepr {
+            x: 0,
             pixels: Records::Values(&row),
             ..repr()
         };
@@ -326,23 +350,32 @@ mod tests {
             Error::DecodeUnexpectedEnd
         );
         assert_eq!(
-            Packet::new_checked(&PACKET_BYTES[..16]).unwrap_err(),
+            Packet::new_checked(&PACKET_BYTES[..18]).unwrap_err(),
             Error::DecodeUnexpectedEnd
         );
-        let mut long = [0u8; 18];
-        long[..17].copy_from_slice(&PACKET_BYTES);
+        let mut long = [0u8; 20];
+        long[..19].copy_from_slice(&PACKET_BYTES);
         assert_eq!(
             Packet::new_checked(&long[..]).unwrap_err(),
             Error::DecodeBadLength
         );
         let mut over = [0u8; HEADER_LEN];
-        over[9..11].copy_from_slice(&(MAX_WIDTH as u16 + 1).to_le_bytes());
+        over[11..13].copy_from_slice(&(MAX_WIDTH as u16 + 1).to_le_bytes());
         assert_eq!(
             Packet::new_checked(&over[..]).unwrap_err(),
             Error::DecodeTooManyRecords
         );
-        let wide = [SobelPixel::default(); MAX_WIDTH + 1];
+        // A segment may not reach past the widest row either.
+        let mut past = [0u8; HEADER_LEN + 2];
+        past[9..11].copy_from_slice(&(MAX_WIDTH as u16).to_le_bytes());
+        past[11..13].copy_from_slice(&1u16.to_le_bytes());
+        assert_eq!(
+            Packet::new_checked(&past[..]).unwrap_err(),
+            Error::DecodeTooManyRecords
+        );
+        let wide = [SobelPixel::default(); MAX_WIDTH];
         let repr = SobelRowsRepr {
+            x: 1,
             pixels: Records::Values(&wide),
             ..repr()
         };
@@ -351,7 +384,7 @@ mod tests {
             repr.emit(&mut Packet::new_unchecked(&mut out[..])),
             Err(Error::EncodeTooManyRecords)
         );
-        let mut short = [0u8; 16];
+        let mut short = [0u8; 18];
         assert_eq!(
             self::repr().emit(&mut Packet::new_unchecked(&mut short[..])),
             Err(Error::EncodeBufferTooSmall)

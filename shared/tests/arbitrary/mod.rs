@@ -24,6 +24,7 @@ pub enum OwnedPacket {
         octave: u8,
         scale: u8,
         row: u16,
+        x: u16,
         pixels: Vec<SobelPixel>,
     },
     SobelPatch {
@@ -58,6 +59,7 @@ impl OwnedPacket {
                 octave,
                 scale,
                 row,
+                x,
                 pixels,
             } => PacketRepr::SobelRows(SobelRowsRepr {
                 frame_id: *frame_id,
@@ -65,6 +67,7 @@ impl OwnedPacket {
                 octave: *octave,
                 scale: *scale,
                 row: *row,
+                x: *x,
                 pixels: Records::Values(pixels),
             }),
             OwnedPacket::SobelPatch {
@@ -189,15 +192,19 @@ pub fn packet() -> impl Strategy<Value = OwnedPacket> {
             any::<u32>(),
             camera(),
             any::<(u8, u8, u16)>(),
-            vec(sobel_pixel(), 0..=MAX_SOBEL_ROW_WIDTH)
+            vec(sobel_pixel(), 0..=MAX_SOBEL_ROW_WIDTH),
+            0..=MAX_SOBEL_ROW_WIDTH
         )
-            .prop_map(|(frame_id, camera, (octave, scale, row), pixels)| {
+            .prop_map(|(frame_id, camera, (octave, scale, row), pixels, x)| {
+                // A segment ends within the widest row.
+                let x = x.min(MAX_SOBEL_ROW_WIDTH - pixels.len()) as u16;
                 OwnedPacket::SobelRows {
                     frame_id,
                     camera,
                     octave,
                     scale,
                     row,
+                    x,
                     pixels,
                 }
             }),

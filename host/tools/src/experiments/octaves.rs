@@ -20,7 +20,7 @@ use super::{ExperimentError, Outcome, Progress, Table};
 use stereocal::estimator::EstimatorConfig;
 use stereocal::matching::MatchConfig;
 use stereocal::output::plot::FAMILY;
-use stereocal::output::record::{FrameRecord, FrameStatus};
+use stereocal::output::record::FrameRecord;
 use stereocal::session::SessionConfig;
 use stereocal_synth::{SceneKind, TrajectoryKind};
 
@@ -37,7 +37,7 @@ impl OctaveTally {
     /// Sums `per_octave(r)` over the estimated frames of `records`.
     pub fn over(records: &[FrameRecord], per_octave: impl Fn(&FrameRecord) -> &[usize]) -> Self {
         let mut counts = Vec::new();
-        for r in records.iter().filter(|r| r.status == FrameStatus::Ok) {
+        for r in records.iter().filter(|r| r.status.has_estimate()) {
             let frame = per_octave(r);
             if frame.len() > counts.len() {
                 counts.resize(frame.len(), 0);
@@ -272,11 +272,13 @@ fn draw(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use stereocal::output::record::FrameStatus;
 
     fn record(status: FrameStatus, matches: Vec<usize>) -> FrameRecord {
         FrameRecord {
             frame: 0,
             raw_verge_deg: None,
+            raw_sigma_deg: None,
             filtered_verge_deg: None,
             filtered_sigma_deg: None,
             matches: matches.iter().sum(),
@@ -287,6 +289,7 @@ mod tests {
             truth_deg: None,
             dropped_because: None,
             misalignment: None,
+            link_loss: None,
         }
     }
 

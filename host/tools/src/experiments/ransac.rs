@@ -16,7 +16,6 @@ use super::run::{p95, range, Run, RunSpec};
 use super::table::fixed;
 use super::{ExperimentError, Outcome, Progress, Table};
 use stereocal::estimator::EstimatorConfig;
-use stereocal::output::record::FrameStatus;
 use stereocal::output::summary::median;
 use stereocal::session::SessionConfig;
 use stereocal_synth::{SceneKind, TrajectoryKind};
@@ -125,7 +124,7 @@ fn largest_filtered_difference(on: &Run, off: &Run) -> Option<f64> {
     let filtered = |run: &Run| -> HashMap<usize, f64> {
         run.records
             .iter()
-            .filter(|r| r.status == FrameStatus::Ok)
+            .filter(|r| r.status.has_estimate())
             .filter_map(|r| Some((r.frame, r.filtered_verge_deg?)))
             .collect()
     };

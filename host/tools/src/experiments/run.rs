@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use super::{ExperimentError, Progress};
 use crate::eval::evaluate;
-use stereocal::output::record::{FrameRecord, FrameStatus};
+use stereocal::output::record::FrameRecord;
 use stereocal::output::report::write_outputs;
 use stereocal::output::summary::{percentile, settled_from, Residual, Summary};
 use stereocal::session::{SessionConfig, SessionCost};
@@ -80,7 +80,7 @@ impl Run {
     fn errors(&self, value: impl Fn(&FrameRecord) -> Option<f64>) -> Vec<f64> {
         self.records
             .iter()
-            .filter(|r| r.status == FrameStatus::Ok)
+            .filter(|r| r.status.has_estimate())
             .filter_map(|r| Some((value(r)? - r.truth_deg?).abs()))
             .collect()
     }
@@ -102,7 +102,7 @@ impl Run {
         let settled_from = settled_from(self.records.len());
         self.records
             .iter()
-            .filter(|r| r.status == FrameStatus::Ok && r.frame >= settled_from)
+            .filter(|r| r.status.has_estimate() && r.frame >= settled_from)
             .filter_map(|r| r.filtered_verge_deg)
             .collect()
     }
@@ -111,7 +111,7 @@ impl Run {
     pub(crate) fn raw(&self) -> Vec<f64> {
         self.records
             .iter()
-            .filter(|r| r.status == FrameStatus::Ok)
+            .filter(|r| r.status.has_estimate())
             .filter_map(|r| r.raw_verge_deg)
             .collect()
     }
