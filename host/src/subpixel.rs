@@ -166,6 +166,31 @@ fn sample_warped(
     Some(())
 }
 
+/// One row of the template and its central-difference gradients: `row` is the template row
+/// with one sample of border each side, `above` and `below` the rows around it (the plane's
+/// `u8` magnitudes, or a warped window's `f32` samples).
+fn template_row<T: Copy + Into<f32>>(
+    row: &[T],
+    above: &[T],
+    below: &[T],
+    t_row: &mut [f32],
+    gx_row: &mut [f32],
+    gy_row: &mut [f32],
+) {
+    let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
+    let cells = t_row
+        .iter_mut()
+        .zip(gx_row.iter_mut())
+        .zip(gy_row.iter_mut());
+    for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
+        cells.zip(horizontal).zip(above.iter().zip(below))
+    {
+        *tv = c.into();
+        *gxv = 0.5 * (r.into() - l.into());
+        *gyv = 0.5 * (b.into() - a.into());
+    }
+}
+
 thread_local! {
     /// [`refine_pair`]'s working arrays, kept per thread between calls: a match needs seven
     /// window-sized arrays, and taking them from here spares their allocation (or the zeroing
@@ -301,18 +326,7 @@ fn refine_in(
                 let row = &m[(y0 + r) * stride + x0 - 1..][..side + 2];
                 let above = &m[(y0 + r - 1) * stride + x0..][..side];
                 let below = &m[(y0 + r + 1) * stride + x0..][..side];
-                let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
-                let cells = t_row
-                    .iter_mut()
-                    .zip(gx_row.iter_mut())
-                    .zip(gy_row.iter_mut());
-                for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
-                    cells.zip(horizontal).zip(above.iter().zip(below))
-                {
-                    *tv = f32::from(c);
-                    *gxv = 0.5 * (f32::from(r) - f32::from(l));
-                    *gyv = 0.5 * (f32::from(b) - f32::from(a));
-                }
+                template_row(row, above, below, t_row, gx_row, gy_row);
             }
         }
         Some(&[a, b, c, d]) => {
@@ -334,18 +348,7 @@ fn refine_in(
                 let row = &bordered[(r + 1) * stride..][..stride];
                 let above = &bordered[r * stride + 1..][..side];
                 let below = &bordered[(r + 2) * stride + 1..][..side];
-                let horizontal = row.iter().zip(&row[1..]).zip(&row[2..]);
-                let cells = t_row
-                    .iter_mut()
-                    .zip(gx_row.iter_mut())
-                    .zip(gy_row.iter_mut());
-                for ((((tv, gxv), gyv), ((&l, &c), &r)), (&a, &b)) in
-                    cells.zip(horizontal).zip(above.iter().zip(below))
-                {
-                    *tv = c;
-                    *gxv = 0.5 * (r - l);
-                    *gyv = 0.5 * (b - a);
-                }
+                template_row(row, above, below, t_row, gx_row, gy_row);
             }
         }
     }

@@ -247,15 +247,18 @@ fn many_points(frame_id: u32) -> FrameSpec {
     spec
 }
 
+/// `spec` sent with the second of its five 128-point batches lost, as the salvaging driver
+/// delivers it.
+fn losing_the_second_point_batch(spec: FrameSpec) -> ReceivedFrame {
+    let mut wire = Wire::new();
+    let batch = frame_packets(&spec).len() - 5;
+    wire.frame_losing(&spec, &[batch]);
+    delivered(salvaging(&wire).next_frame(T).unwrap())
+}
+
 #[test]
 fn a_lost_point_batch_costs_its_points_in_rows_mode() {
-    let mut wire = Wire::new();
-    let spec = many_points(5);
-    let packets = frame_packets(&spec);
-    // The second of the five point batches.
-    let batch = packets.len() - 5;
-    wire.frame_losing(&spec, &[batch]);
-    let f = delivered(salvaging(&wire).next_frame(T).unwrap());
+    let f = losing_the_second_point_batch(many_points(5));
     let salvage = f.salvage.expect("salvaged");
     assert_eq!(
         (salvage.points_lost, salvage.rows_lost_total()),
@@ -266,13 +269,9 @@ fn a_lost_point_batch_costs_its_points_in_rows_mode() {
 
 #[test]
 fn patches_after_a_lost_point_batch_find_their_points_by_placement() {
-    let mut wire = Wire::new();
     let mut spec = many_points(6);
     spec.sobel = Sobel::Patches((0..600).collect());
-    let packets = frame_packets(&spec);
-    let batch = packets.len() - 5;
-    wire.frame_losing(&spec, &[batch]);
-    let f = delivered(salvaging(&wire).next_frame(T).unwrap());
+    let f = losing_the_second_point_batch(spec);
     let salvage = f.salvage.expect("salvaged");
     assert_eq!(
         (salvage.points_lost, salvage.patches_lost),

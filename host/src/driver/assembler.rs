@@ -687,12 +687,12 @@ fn plane_over_limit(features: &FeatureFrame, limit: f64) -> Option<Damage> {
         return None;
     };
     planes.iter().find_map(|plane| {
-        let pixels = u64::from(plane.width()) * u64::from(plane.height());
-        let lost = plane.lost_pixels() as u64;
-        (lost as f64 > limit * pixels as f64).then(|| Damage::PlaneLost {
+        let pixels = plane.width().saturating_mul(plane.height());
+        let lost = u32::try_from(plane.lost_pixels()).unwrap_or(u32::MAX);
+        (!within_limit(lost, pixels, limit)).then_some(Damage::PlaneLost {
             octave: plane.octave(),
-            lost: lost.min(u64::from(u32::MAX)) as u32,
-            of: pixels.min(u64::from(u32::MAX)) as u32,
+            lost,
+            of: pixels,
         })
     })
 }
