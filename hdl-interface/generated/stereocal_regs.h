@@ -8,7 +8,7 @@
 #define STEREOCAL_WINDOW_SIZE 0x100u
 #define STEREOCAL_REGISTER_WIDTH 32u
 #define STEREOCAL_VERSION_MAJOR 2u
-#define STEREOCAL_VERSION_MINOR 0u
+#define STEREOCAL_VERSION_MINOR 1u
 #define STEREOCAL_MAX_HEIGHT 1024u
 #define STEREOCAL_MAX_OCTAVES 4u
 #define STEREOCAL_MAX_WIDTH 1280u
@@ -18,12 +18,12 @@
 
 /* VERSION (ro): Identifies the fabric and the register-map version it implements. */
 #define STEREOCAL_VERSION_OFFSET 0x00u
-#define STEREOCAL_VERSION_RESET 0x5C010200u
+#define STEREOCAL_VERSION_RESET 0x5C010201u
 /* [7:0] ro: Register-map minor version (additive changes only). */
 #define STEREOCAL_VERSION_MINOR_SHIFT 0u
 #define STEREOCAL_VERSION_MINOR_WIDTH 8u
 #define STEREOCAL_VERSION_MINOR_MASK 0x000000FFu
-#define STEREOCAL_VERSION_MINOR_RESET 0x0u
+#define STEREOCAL_VERSION_MINOR_RESET 0x1u
 /* [15:8] ro: Register-map major version (incompatible changes). */
 #define STEREOCAL_VERSION_MAJOR_SHIFT 8u
 #define STEREOCAL_VERSION_MAJOR_WIDTH 8u
@@ -57,12 +57,12 @@
 /* STATUS (w1c): Pipeline state and sticky event flags. */
 #define STEREOCAL_STATUS_OFFSET 0x08u
 #define STEREOCAL_STATUS_RESET 0x00000000u
-/* [0:0] ro: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs. */
+/* [0:0] ro: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs and, while STREAM_CONTROL.ENABLE is 1, until the stream engine has sent the frame's FrameEnd. */
 #define STEREOCAL_STATUS_BUSY_SHIFT 0u
 #define STEREOCAL_STATUS_BUSY_WIDTH 1u
 #define STEREOCAL_STATUS_BUSY_MASK 0x00000001u
 #define STEREOCAL_STATUS_BUSY_RESET 0x0u
-/* [1:1] w1c: Set when BUSY falls: every entry of the frame is in the FIFOs. */
+/* [1:1] w1c: Set when BUSY falls: every entry of the frame is in the FIFOs (or, with the stream engine enabled, sent). */
 #define STEREOCAL_STATUS_FRAME_DONE_SHIFT 1u
 #define STEREOCAL_STATUS_FRAME_DONE_WIDTH 1u
 #define STEREOCAL_STATUS_FRAME_DONE_MASK 0x00000002u
@@ -131,16 +131,16 @@
 #define STEREOCAL_EDGE_THRESHOLD_R_MIN 1u
 #define STEREOCAL_EDGE_THRESHOLD_R_MAX 31u
 
-/* OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points. */
+/* OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the stream engine packs the Sobel stream and the points. */
 #define STEREOCAL_OUTPUT_MODE_OFFSET 0x20u
 #define STEREOCAL_OUTPUT_MODE_RESET 0x05001011u
-/* [0:0] rw: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO. */
+/* [0:0] rw: How the stream engine sends the Sobel stream to the host. The datapath does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO. */
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_SHIFT 0u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_WIDTH 1u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_MASK 0x00000001u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_RESET 0x1u
-#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_ROWS 0u /* The driver sends every row of every octave (SobelRows packets). */
-#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES 1u /* The driver cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the fabric still streams every pixel. */
+#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_ROWS 0u /* The stream engine sends every row of every octave (SobelRows packets). */
+#define STEREOCAL_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES 1u /* The stream engine cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the datapath still streams every pixel. */
 /* [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit in every octave (Config::sobel_scale). */
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_SHIFT 4u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_WIDTH 2u
@@ -148,14 +148,14 @@
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_RESET 0x1u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_MIN 0u
 #define STEREOCAL_OUTPUT_MODE_SOBEL_SCALE_MAX 3u
-/* [15:8] rw, valid 1..128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage). */
+/* [15:8] rw, valid 1..128: Most points the stream engine puts in one PointBatch packet (the wire allows 128). A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage). */
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_SHIFT 8u
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_WIDTH 8u
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MASK 0x0000FF00u
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_RESET 0x10u
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MIN 1u
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MAX 128u
-/* [26:16] rw, valid 16..1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels). */
+/* [26:16] rw, valid 16..1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels). */
 #define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_SHIFT 16u
 #define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_WIDTH 11u
 #define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_MASK 0x07FF0000u
@@ -327,11 +327,117 @@
 #define STEREOCAL_MAX_OFFSET_VALUE_MIN 0u
 #define STEREOCAL_MAX_OFFSET_VALUE_MAX 8191u
 
+/* STREAM_CONTROL (rw): Stream engine control, sampled at each FRAME_ARM (FEC at each link frame). */
+#define STEREOCAL_STREAM_CONTROL_OFFSET 0x54u
+#define STEREOCAL_STREAM_CONTROL_RESET 0x00000000u
+/* [0:0] rw: 1: the stream engine drains both FIFOs and sends the frame's packets on LINK_OUT. 0: the FIFOs wait for the bus (POINT_FIFO_DATA, SOBEL_FIFO_DATA), as for bring-up and the register contract test; LINK_OUT stays idle. */
+#define STEREOCAL_STREAM_CONTROL_ENABLE_SHIFT 0u
+#define STEREOCAL_STREAM_CONTROL_ENABLE_WIDTH 1u
+#define STEREOCAL_STREAM_CONTROL_ENABLE_MASK 0x00000001u
+#define STEREOCAL_STREAM_CONTROL_ENABLE_RESET 0x0u
+/* [1:1] rw: 1: every link frame the engine sends carries RS(255,239) parity (wire-format.md, Forward error correction). The driver sets it when the host asks for FEC in its Hello. */
+#define STEREOCAL_STREAM_CONTROL_FEC_SHIFT 1u
+#define STEREOCAL_STREAM_CONTROL_FEC_WIDTH 1u
+#define STEREOCAL_STREAM_CONTROL_FEC_MASK 0x00000002u
+#define STEREOCAL_STREAM_CONTROL_FEC_RESET 0x0u
+/* [15:8] rw: The camera this channel serves: the packets' camera field and their wire source (1 + CAMERA). */
+#define STEREOCAL_STREAM_CONTROL_CAMERA_SHIFT 8u
+#define STEREOCAL_STREAM_CONTROL_CAMERA_WIDTH 8u
+#define STEREOCAL_STREAM_CONTROL_CAMERA_MASK 0x0000FF00u
+#define STEREOCAL_STREAM_CONTROL_CAMERA_RESET 0x0u
+
+/* FRAME_ID (rw): The frame number the next frame's packets carry, latched at FRAME_ARM. */
+#define STEREOCAL_FRAME_ID_OFFSET 0x58u
+#define STEREOCAL_FRAME_ID_RESET 0x00000000u
+/* [31:0] rw: FrameStart.frame_id and every later packet's of the frame; the driver counts frames and writes it before each FRAME_ARM. */
+#define STEREOCAL_FRAME_ID_VALUE_SHIFT 0u
+#define STEREOCAL_FRAME_ID_VALUE_WIDTH 32u
+#define STEREOCAL_FRAME_ID_VALUE_MASK 0xFFFFFFFFu
+#define STEREOCAL_FRAME_ID_VALUE_RESET 0x0u
+
+/* TIMESTAMP_LO (rw): Low word of the next frame's capture time, latched at FRAME_ARM. */
+#define STEREOCAL_TIMESTAMP_LO_OFFSET 0x5Cu
+#define STEREOCAL_TIMESTAMP_LO_RESET 0x00000000u
+/* [31:0] rw: FrameStart.timestamp_us bits 31..0 (microseconds). */
+#define STEREOCAL_TIMESTAMP_LO_VALUE_SHIFT 0u
+#define STEREOCAL_TIMESTAMP_LO_VALUE_WIDTH 32u
+#define STEREOCAL_TIMESTAMP_LO_VALUE_MASK 0xFFFFFFFFu
+#define STEREOCAL_TIMESTAMP_LO_VALUE_RESET 0x0u
+
+/* TIMESTAMP_HI (rw): High word of the next frame's capture time, latched at FRAME_ARM. */
+#define STEREOCAL_TIMESTAMP_HI_OFFSET 0x60u
+#define STEREOCAL_TIMESTAMP_HI_RESET 0x00000000u
+/* [31:0] rw: FrameStart.timestamp_us bits 63..32. */
+#define STEREOCAL_TIMESTAMP_HI_VALUE_SHIFT 0u
+#define STEREOCAL_TIMESTAMP_HI_VALUE_WIDTH 32u
+#define STEREOCAL_TIMESTAMP_HI_VALUE_MASK 0xFFFFFFFFu
+#define STEREOCAL_TIMESTAMP_HI_VALUE_RESET 0x0u
+
+/* STREAM_POINTS (ro): Points the stream engine sent in the current (or last) frame's PointBatch packets: FrameEnd.point_count. */
+#define STEREOCAL_STREAM_POINTS_OFFSET 0x64u
+#define STEREOCAL_STREAM_POINTS_RESET 0x00000000u
+/* [31:0] ro: Zeroed at FRAME_ARM; saturates. */
+#define STEREOCAL_STREAM_POINTS_COUNT_SHIFT 0u
+#define STEREOCAL_STREAM_POINTS_COUNT_WIDTH 32u
+#define STEREOCAL_STREAM_POINTS_COUNT_MASK 0xFFFFFFFFu
+#define STEREOCAL_STREAM_POINTS_COUNT_RESET 0x0u
+
+/* STREAM_SOBEL_PACKETS (ro): SobelRows or SobelPatch packets the stream engine sent in the current (or last) frame: FrameEnd.sobel_count. */
+#define STEREOCAL_STREAM_SOBEL_PACKETS_OFFSET 0x68u
+#define STEREOCAL_STREAM_SOBEL_PACKETS_RESET 0x00000000u
+/* [31:0] ro: Zeroed at FRAME_ARM; saturates. */
+#define STEREOCAL_STREAM_SOBEL_PACKETS_COUNT_SHIFT 0u
+#define STEREOCAL_STREAM_SOBEL_PACKETS_COUNT_WIDTH 32u
+#define STEREOCAL_STREAM_SOBEL_PACKETS_COUNT_MASK 0xFFFFFFFFu
+#define STEREOCAL_STREAM_SOBEL_PACKETS_COUNT_RESET 0x0u
+
+/* STREAM_PATCHES_DROPPED (ro): Points of the current (or last) frame that got no patch: their top rows had left the engine's row ring, or its queue of waiting points was full. FrameEnd.dropped_sobel adds them to SOBEL_OVERFLOW_COUNT's growth. */
+#define STEREOCAL_STREAM_PATCHES_DROPPED_OFFSET 0x6Cu
+#define STEREOCAL_STREAM_PATCHES_DROPPED_RESET 0x00000000u
+/* [31:0] ro: Zeroed at FRAME_ARM; saturates. */
+#define STEREOCAL_STREAM_PATCHES_DROPPED_COUNT_SHIFT 0u
+#define STEREOCAL_STREAM_PATCHES_DROPPED_COUNT_WIDTH 32u
+#define STEREOCAL_STREAM_PATCHES_DROPPED_COUNT_MASK 0xFFFFFFFFu
+#define STEREOCAL_STREAM_PATCHES_DROPPED_COUNT_RESET 0x0u
+
+/* STREAM_FAULT (ro): Why the stream engine stopped sending the current (or last) frame, with the record that stopped it. A frame with a fault gets no FrameEnd; the driver reports the fault to the host. Zeroed at FRAME_ARM. */
+#define STEREOCAL_STREAM_FAULT_OFFSET 0x70u
+#define STEREOCAL_STREAM_FAULT_RESET 0x00000000u
+/* [1:0] ro: What stopped the frame. */
+#define STEREOCAL_STREAM_FAULT_CAUSE_SHIFT 0u
+#define STEREOCAL_STREAM_FAULT_CAUSE_WIDTH 2u
+#define STEREOCAL_STREAM_FAULT_CAUSE_MASK 0x00000003u
+#define STEREOCAL_STREAM_FAULT_CAUSE_RESET 0x0u
+#define STEREOCAL_STREAM_FAULT_CAUSE_NONE 0u /* No fault. */
+#define STEREOCAL_STREAM_FAULT_CAUSE_SOBEL_ORDER 1u /* A Sobel pixel outside its octave's image or behind a row already complete (a datapath defect). */
+#define STEREOCAL_STREAM_FAULT_CAUSE_POINT_OUTSIDE 2u /* A point outside its octave's image (a datapath defect). */
+#define STEREOCAL_STREAM_FAULT_CAUSE_ENCODE 3u /* A packet the framer could not encode (an engine defect: every packet is within the wire limits). */
+/* [3:2] ro: The record's octave. */
+#define STEREOCAL_STREAM_FAULT_OCTAVE_SHIFT 2u
+#define STEREOCAL_STREAM_FAULT_OCTAVE_WIDTH 2u
+#define STEREOCAL_STREAM_FAULT_OCTAVE_MASK 0x0000000Cu
+#define STEREOCAL_STREAM_FAULT_OCTAVE_RESET 0x0u
+/* [14:4] ro: The record's column (its low 11 bits). */
+#define STEREOCAL_STREAM_FAULT_X_SHIFT 4u
+#define STEREOCAL_STREAM_FAULT_X_WIDTH 11u
+#define STEREOCAL_STREAM_FAULT_X_MASK 0x00007FF0u
+#define STEREOCAL_STREAM_FAULT_X_RESET 0x0u
+/* [25:15] ro: The record's row (its low 11 bits). */
+#define STEREOCAL_STREAM_FAULT_Y_SHIFT 15u
+#define STEREOCAL_STREAM_FAULT_Y_WIDTH 11u
+#define STEREOCAL_STREAM_FAULT_Y_MASK 0x03FF8000u
+#define STEREOCAL_STREAM_FAULT_Y_RESET 0x0u
+
 /* Stream port PIXEL_IN (in): Camera pixels, raster order, at most one per clock. */
 #define STEREOCAL_PORT_PIXEL_IN_DATA_WIDTH 8u
 #define STEREOCAL_PORT_PIXEL_IN_VALID_WIDTH 1u
 #define STEREOCAL_PORT_PIXEL_IN_READY_WIDTH 1u
 #define STEREOCAL_PORT_PIXEL_IN_SOF_WIDTH 1u
 #define STEREOCAL_PORT_PIXEL_IN_EOL_WIDTH 1u
+
+/* Stream port LINK_OUT (out): The stream engine's link frames (COBS bytes, each frame ending in its 0x00 delimiter), one byte per clock, to the link's transmitter. */
+#define STEREOCAL_PORT_LINK_OUT_DATA_WIDTH 8u
+#define STEREOCAL_PORT_LINK_OUT_VALID_WIDTH 1u
+#define STEREOCAL_PORT_LINK_OUT_READY_WIDTH 1u
 
 #endif /* STEREOCAL_REGS_H */

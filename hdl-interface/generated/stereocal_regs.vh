@@ -8,7 +8,7 @@ localparam integer SC_WINDOW_SIZE = 256;
 localparam integer SC_OFFSET_BITS = 8;
 localparam integer SC_REGISTER_WIDTH = 32;
 localparam [7:0] SC_VERSION_MAJOR = 8'd2;
-localparam [7:0] SC_VERSION_MINOR = 8'd0;
+localparam [7:0] SC_VERSION_MINOR = 8'd1;
 localparam integer SC_MAX_HEIGHT = 1024;
 localparam integer SC_MAX_OCTAVES = 4;
 localparam integer SC_MAX_WIDTH = 1280;
@@ -18,13 +18,13 @@ localparam integer SC_SOBEL_FIFO_DEPTH = 3840;
 
 // VERSION (ro): Identifies the fabric and the register-map version it implements.
 localparam [7:0] SC_VERSION_OFFSET = 8'h00;
-localparam [31:0] SC_VERSION_RESET = 32'h5C010200;
+localparam [31:0] SC_VERSION_RESET = 32'h5C010201;
 // [7:0] ro: Register-map minor version (additive changes only).
 localparam integer SC_VERSION_MINOR_LSB = 0;
 localparam integer SC_VERSION_MINOR_MSB = 7;
 localparam integer SC_VERSION_MINOR_WIDTH = 8;
 localparam [31:0] SC_VERSION_MINOR_MASK = 32'h000000FF;
-localparam [7:0] SC_VERSION_MINOR_RESET = 8'h0;
+localparam [7:0] SC_VERSION_MINOR_RESET = 8'h1;
 // [15:8] ro: Register-map major version (incompatible changes).
 localparam integer SC_VERSION_MAJOR_LSB = 8;
 localparam integer SC_VERSION_MAJOR_MSB = 15;
@@ -63,13 +63,13 @@ localparam [0:0] SC_CONTROL_SOFT_RESET_RESET = 1'h0;
 // STATUS (w1c): Pipeline state and sticky event flags.
 localparam [7:0] SC_STATUS_OFFSET = 8'h08;
 localparam [31:0] SC_STATUS_RESET = 32'h00000000;
-// [0:0] ro: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs.
+// [0:0] ro: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs and, while STREAM_CONTROL.ENABLE is 1, until the stream engine has sent the frame's FrameEnd.
 localparam integer SC_STATUS_BUSY_LSB = 0;
 localparam integer SC_STATUS_BUSY_MSB = 0;
 localparam integer SC_STATUS_BUSY_WIDTH = 1;
 localparam [31:0] SC_STATUS_BUSY_MASK = 32'h00000001;
 localparam [0:0] SC_STATUS_BUSY_RESET = 1'h0;
-// [1:1] w1c: Set when BUSY falls: every entry of the frame is in the FIFOs.
+// [1:1] w1c: Set when BUSY falls: every entry of the frame is in the FIFOs (or, with the stream engine enabled, sent).
 localparam integer SC_STATUS_FRAME_DONE_LSB = 1;
 localparam integer SC_STATUS_FRAME_DONE_MSB = 1;
 localparam integer SC_STATUS_FRAME_DONE_WIDTH = 1;
@@ -138,30 +138,30 @@ localparam integer SC_EDGE_THRESHOLD_R_WIDTH = 5;
 localparam [31:0] SC_EDGE_THRESHOLD_R_MASK = 32'h0000001F;
 localparam [4:0] SC_EDGE_THRESHOLD_R_RESET = 5'hA;
 
-// OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points.
+// OUTPUT_MODE (rw): Which scale feeds the Sobel unit, and how the stream engine packs the Sobel stream and the points.
 localparam [7:0] SC_OUTPUT_MODE_OFFSET = 8'h20;
 localparam [31:0] SC_OUTPUT_MODE_RESET = 32'h05001011;
-// [0:0] rw: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
+// [0:0] rw: How the stream engine sends the Sobel stream to the host. The datapath does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_LSB = 0;
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_MSB = 0;
 localparam integer SC_OUTPUT_MODE_SOBEL_OUTPUT_WIDTH = 1;
 localparam [31:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_MASK = 32'h00000001;
 localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_RESET = 1'h1;
-localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_ROWS = 1'd0; // The driver sends every row of every octave (SobelRows packets).
-localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES = 1'd1; // The driver cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the fabric still streams every pixel.
+localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_ROWS = 1'd0; // The stream engine sends every row of every octave (SobelRows packets).
+localparam [0:0] SC_OUTPUT_MODE_SOBEL_OUTPUT_PATCHES = 1'd1; // The stream engine cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the datapath still streams every pixel.
 // [5:4] rw, valid 0..3: Gaussian scale (0 = G0 .. 3 = G3) whose image feeds the Sobel unit in every octave (Config::sobel_scale).
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_LSB = 4;
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_MSB = 5;
 localparam integer SC_OUTPUT_MODE_SOBEL_SCALE_WIDTH = 2;
 localparam [31:0] SC_OUTPUT_MODE_SOBEL_SCALE_MASK = 32'h00000030;
 localparam [1:0] SC_OUTPUT_MODE_SOBEL_SCALE_RESET = 2'h1;
-// [15:8] rw, valid 1..128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
+// [15:8] rw, valid 1..128: Most points the stream engine puts in one PointBatch packet (the wire allows 128). A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
 localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_LSB = 8;
 localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_MSB = 15;
 localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_WIDTH = 8;
 localparam [31:0] SC_OUTPUT_MODE_POINTS_PER_BATCH_MASK = 32'h0000FF00;
 localparam [7:0] SC_OUTPUT_MODE_POINTS_PER_BATCH_RESET = 8'h10;
-// [26:16] rw, valid 16..1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+// [26:16] rw, valid 16..1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
 localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_LSB = 16;
 localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_MSB = 26;
 localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_WIDTH = 11;
@@ -348,10 +348,129 @@ localparam integer SC_MAX_OFFSET_VALUE_WIDTH = 16;
 localparam [31:0] SC_MAX_OFFSET_VALUE_MASK = 32'h0000FFFF;
 localparam [15:0] SC_MAX_OFFSET_VALUE_RESET = 16'h1000;
 
+// STREAM_CONTROL (rw): Stream engine control, sampled at each FRAME_ARM (FEC at each link frame).
+localparam [7:0] SC_STREAM_CONTROL_OFFSET = 8'h54;
+localparam [31:0] SC_STREAM_CONTROL_RESET = 32'h00000000;
+// [0:0] rw: 1: the stream engine drains both FIFOs and sends the frame's packets on LINK_OUT. 0: the FIFOs wait for the bus (POINT_FIFO_DATA, SOBEL_FIFO_DATA), as for bring-up and the register contract test; LINK_OUT stays idle.
+localparam integer SC_STREAM_CONTROL_ENABLE_LSB = 0;
+localparam integer SC_STREAM_CONTROL_ENABLE_MSB = 0;
+localparam integer SC_STREAM_CONTROL_ENABLE_WIDTH = 1;
+localparam [31:0] SC_STREAM_CONTROL_ENABLE_MASK = 32'h00000001;
+localparam [0:0] SC_STREAM_CONTROL_ENABLE_RESET = 1'h0;
+// [1:1] rw: 1: every link frame the engine sends carries RS(255,239) parity (wire-format.md, Forward error correction). The driver sets it when the host asks for FEC in its Hello.
+localparam integer SC_STREAM_CONTROL_FEC_LSB = 1;
+localparam integer SC_STREAM_CONTROL_FEC_MSB = 1;
+localparam integer SC_STREAM_CONTROL_FEC_WIDTH = 1;
+localparam [31:0] SC_STREAM_CONTROL_FEC_MASK = 32'h00000002;
+localparam [0:0] SC_STREAM_CONTROL_FEC_RESET = 1'h0;
+// [15:8] rw: The camera this channel serves: the packets' camera field and their wire source (1 + CAMERA).
+localparam integer SC_STREAM_CONTROL_CAMERA_LSB = 8;
+localparam integer SC_STREAM_CONTROL_CAMERA_MSB = 15;
+localparam integer SC_STREAM_CONTROL_CAMERA_WIDTH = 8;
+localparam [31:0] SC_STREAM_CONTROL_CAMERA_MASK = 32'h0000FF00;
+localparam [7:0] SC_STREAM_CONTROL_CAMERA_RESET = 8'h0;
+
+// FRAME_ID (rw): The frame number the next frame's packets carry, latched at FRAME_ARM.
+localparam [7:0] SC_FRAME_ID_OFFSET = 8'h58;
+localparam [31:0] SC_FRAME_ID_RESET = 32'h00000000;
+// [31:0] rw: FrameStart.frame_id and every later packet's of the frame; the driver counts frames and writes it before each FRAME_ARM.
+localparam integer SC_FRAME_ID_VALUE_LSB = 0;
+localparam integer SC_FRAME_ID_VALUE_MSB = 31;
+localparam integer SC_FRAME_ID_VALUE_WIDTH = 32;
+localparam [31:0] SC_FRAME_ID_VALUE_MASK = 32'hFFFFFFFF;
+localparam [31:0] SC_FRAME_ID_VALUE_RESET = 32'h0;
+
+// TIMESTAMP_LO (rw): Low word of the next frame's capture time, latched at FRAME_ARM.
+localparam [7:0] SC_TIMESTAMP_LO_OFFSET = 8'h5C;
+localparam [31:0] SC_TIMESTAMP_LO_RESET = 32'h00000000;
+// [31:0] rw: FrameStart.timestamp_us bits 31..0 (microseconds).
+localparam integer SC_TIMESTAMP_LO_VALUE_LSB = 0;
+localparam integer SC_TIMESTAMP_LO_VALUE_MSB = 31;
+localparam integer SC_TIMESTAMP_LO_VALUE_WIDTH = 32;
+localparam [31:0] SC_TIMESTAMP_LO_VALUE_MASK = 32'hFFFFFFFF;
+localparam [31:0] SC_TIMESTAMP_LO_VALUE_RESET = 32'h0;
+
+// TIMESTAMP_HI (rw): High word of the next frame's capture time, latched at FRAME_ARM.
+localparam [7:0] SC_TIMESTAMP_HI_OFFSET = 8'h60;
+localparam [31:0] SC_TIMESTAMP_HI_RESET = 32'h00000000;
+// [31:0] rw: FrameStart.timestamp_us bits 63..32.
+localparam integer SC_TIMESTAMP_HI_VALUE_LSB = 0;
+localparam integer SC_TIMESTAMP_HI_VALUE_MSB = 31;
+localparam integer SC_TIMESTAMP_HI_VALUE_WIDTH = 32;
+localparam [31:0] SC_TIMESTAMP_HI_VALUE_MASK = 32'hFFFFFFFF;
+localparam [31:0] SC_TIMESTAMP_HI_VALUE_RESET = 32'h0;
+
+// STREAM_POINTS (ro): Points the stream engine sent in the current (or last) frame's PointBatch packets: FrameEnd.point_count.
+localparam [7:0] SC_STREAM_POINTS_OFFSET = 8'h64;
+localparam [31:0] SC_STREAM_POINTS_RESET = 32'h00000000;
+// [31:0] ro: Zeroed at FRAME_ARM; saturates.
+localparam integer SC_STREAM_POINTS_COUNT_LSB = 0;
+localparam integer SC_STREAM_POINTS_COUNT_MSB = 31;
+localparam integer SC_STREAM_POINTS_COUNT_WIDTH = 32;
+localparam [31:0] SC_STREAM_POINTS_COUNT_MASK = 32'hFFFFFFFF;
+localparam [31:0] SC_STREAM_POINTS_COUNT_RESET = 32'h0;
+
+// STREAM_SOBEL_PACKETS (ro): SobelRows or SobelPatch packets the stream engine sent in the current (or last) frame: FrameEnd.sobel_count.
+localparam [7:0] SC_STREAM_SOBEL_PACKETS_OFFSET = 8'h68;
+localparam [31:0] SC_STREAM_SOBEL_PACKETS_RESET = 32'h00000000;
+// [31:0] ro: Zeroed at FRAME_ARM; saturates.
+localparam integer SC_STREAM_SOBEL_PACKETS_COUNT_LSB = 0;
+localparam integer SC_STREAM_SOBEL_PACKETS_COUNT_MSB = 31;
+localparam integer SC_STREAM_SOBEL_PACKETS_COUNT_WIDTH = 32;
+localparam [31:0] SC_STREAM_SOBEL_PACKETS_COUNT_MASK = 32'hFFFFFFFF;
+localparam [31:0] SC_STREAM_SOBEL_PACKETS_COUNT_RESET = 32'h0;
+
+// STREAM_PATCHES_DROPPED (ro): Points of the current (or last) frame that got no patch: their top rows had left the engine's row ring, or its queue of waiting points was full. FrameEnd.dropped_sobel adds them to SOBEL_OVERFLOW_COUNT's growth.
+localparam [7:0] SC_STREAM_PATCHES_DROPPED_OFFSET = 8'h6C;
+localparam [31:0] SC_STREAM_PATCHES_DROPPED_RESET = 32'h00000000;
+// [31:0] ro: Zeroed at FRAME_ARM; saturates.
+localparam integer SC_STREAM_PATCHES_DROPPED_COUNT_LSB = 0;
+localparam integer SC_STREAM_PATCHES_DROPPED_COUNT_MSB = 31;
+localparam integer SC_STREAM_PATCHES_DROPPED_COUNT_WIDTH = 32;
+localparam [31:0] SC_STREAM_PATCHES_DROPPED_COUNT_MASK = 32'hFFFFFFFF;
+localparam [31:0] SC_STREAM_PATCHES_DROPPED_COUNT_RESET = 32'h0;
+
+// STREAM_FAULT (ro): Why the stream engine stopped sending the current (or last) frame, with the record that stopped it. A frame with a fault gets no FrameEnd; the driver reports the fault to the host. Zeroed at FRAME_ARM.
+localparam [7:0] SC_STREAM_FAULT_OFFSET = 8'h70;
+localparam [31:0] SC_STREAM_FAULT_RESET = 32'h00000000;
+// [1:0] ro: What stopped the frame.
+localparam integer SC_STREAM_FAULT_CAUSE_LSB = 0;
+localparam integer SC_STREAM_FAULT_CAUSE_MSB = 1;
+localparam integer SC_STREAM_FAULT_CAUSE_WIDTH = 2;
+localparam [31:0] SC_STREAM_FAULT_CAUSE_MASK = 32'h00000003;
+localparam [1:0] SC_STREAM_FAULT_CAUSE_RESET = 2'h0;
+localparam [1:0] SC_STREAM_FAULT_CAUSE_NONE = 2'd0; // No fault.
+localparam [1:0] SC_STREAM_FAULT_CAUSE_SOBEL_ORDER = 2'd1; // A Sobel pixel outside its octave's image or behind a row already complete (a datapath defect).
+localparam [1:0] SC_STREAM_FAULT_CAUSE_POINT_OUTSIDE = 2'd2; // A point outside its octave's image (a datapath defect).
+localparam [1:0] SC_STREAM_FAULT_CAUSE_ENCODE = 2'd3; // A packet the framer could not encode (an engine defect: every packet is within the wire limits).
+// [3:2] ro: The record's octave.
+localparam integer SC_STREAM_FAULT_OCTAVE_LSB = 2;
+localparam integer SC_STREAM_FAULT_OCTAVE_MSB = 3;
+localparam integer SC_STREAM_FAULT_OCTAVE_WIDTH = 2;
+localparam [31:0] SC_STREAM_FAULT_OCTAVE_MASK = 32'h0000000C;
+localparam [1:0] SC_STREAM_FAULT_OCTAVE_RESET = 2'h0;
+// [14:4] ro: The record's column (its low 11 bits).
+localparam integer SC_STREAM_FAULT_X_LSB = 4;
+localparam integer SC_STREAM_FAULT_X_MSB = 14;
+localparam integer SC_STREAM_FAULT_X_WIDTH = 11;
+localparam [31:0] SC_STREAM_FAULT_X_MASK = 32'h00007FF0;
+localparam [10:0] SC_STREAM_FAULT_X_RESET = 11'h0;
+// [25:15] ro: The record's row (its low 11 bits).
+localparam integer SC_STREAM_FAULT_Y_LSB = 15;
+localparam integer SC_STREAM_FAULT_Y_MSB = 25;
+localparam integer SC_STREAM_FAULT_Y_WIDTH = 11;
+localparam [31:0] SC_STREAM_FAULT_Y_MASK = 32'h03FF8000;
+localparam [10:0] SC_STREAM_FAULT_Y_RESET = 11'h0;
+
 // Stream port PIXEL_IN (in): Camera pixels, raster order, at most one per clock.
 localparam integer SC_PIXEL_IN_DATA_WIDTH = 8; // in: 8-bit grey level.
 localparam integer SC_PIXEL_IN_VALID_WIDTH = 1; // in: DATA, SOF and EOL hold a pixel.
 localparam integer SC_PIXEL_IN_READY_WIDTH = 1; // out: The fabric takes the pixel on this clock.
 localparam integer SC_PIXEL_IN_SOF_WIDTH = 1; // in: Start of frame: this pixel is (0, 0).
 localparam integer SC_PIXEL_IN_EOL_WIDTH = 1; // in: End of line: this pixel is the last of its line. The fabric counts lines by WIDTH and does not check EOL.
+
+// Stream port LINK_OUT (out): The stream engine's link frames (COBS bytes, each frame ending in its 0x00 delimiter), one byte per clock, to the link's transmitter.
+localparam integer SC_LINK_OUT_DATA_WIDTH = 8; // out: A byte of a link frame.
+localparam integer SC_LINK_OUT_VALID_WIDTH = 1; // out: DATA holds a byte.
+localparam integer SC_LINK_OUT_READY_WIDTH = 1; // in: The transmitter takes the byte on this clock; while it is 0 the engine waits (its FIFOs absorb the datapath's records meanwhile, and count what they cannot hold).
 // verilator lint_on UNUSEDPARAM

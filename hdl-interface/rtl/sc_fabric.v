@@ -99,6 +99,15 @@ module sc_fabric #(
     wire [10:0] output_mode_row_segment;
     /* verilator lint_on UNUSEDSIGNAL */
 
+    // The stream engine's registers (docs/STREAM_ENGINE.md). Its RTL block is not written yet:
+    // the Rust model (firmware/src/fabric/stream) defines it, and this fabric behaves as one
+    // whose STREAM_CONTROL.ENABLE is 0 (the FIFOs wait for the bus; the counters read 0).
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire        stream_control_enable, stream_control_fec;
+    wire [7:0]  stream_control_camera;
+    wire [31:0] frame_id_value, timestamp_lo_value, timestamp_hi_value;
+    /* verilator lint_on UNUSEDSIGNAL */
+
     // Point entry: {octave[1:0], dog, ds, dy, dx (16 bits each), y[10:0], x[10:0]} (88 bits);
     // Sobel entry: {octave[1:0], ori[5:0], mag[7:0], y[15:0], x[15:0]} (48 bits).
     wire [87:0] pf_head;
@@ -146,7 +155,15 @@ module sc_fabric #(
         .sobel_fifo_data_valid(sf_nonempty), .sobel_fifo_data_pop(sobel_fifo_data_pop),
         .sobel_fifo_position_x(hold_position[15:0]),
         .sobel_fifo_position_y(hold_position[31:16]),
-        .max_offset_value(max_offset_value)
+        .max_offset_value(max_offset_value),
+        .stream_control_enable(stream_control_enable), .stream_control_fec(stream_control_fec),
+        .stream_control_camera(stream_control_camera),
+        .frame_id_value(frame_id_value), .timestamp_lo_value(timestamp_lo_value),
+        .timestamp_hi_value(timestamp_hi_value),
+        .stream_points_count(32'd0), .stream_sobel_packets_count(32'd0),
+        .stream_patches_dropped_count(32'd0),
+        .stream_fault_cause(2'd0), .stream_fault_octave(2'd0), .stream_fault_x(11'd0),
+        .stream_fault_y(11'd0)
     );
 
     /* verilator lint_off UNUSEDSIGNAL */

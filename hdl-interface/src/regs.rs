@@ -14,7 +14,7 @@ pub const WINDOW_SIZE: u32 = 0x100;
 pub const REGISTER_WIDTH: u32 = 32;
 /// Register-map version this crate was generated for (VERSION.MAJOR / VERSION.MINOR).
 pub const VERSION_MAJOR: u32 = 2;
-pub const VERSION_MINOR: u32 = 0;
+pub const VERSION_MINOR: u32 = 1;
 /// Synthesis parameter `max_height` of the description.
 pub const MAX_HEIGHT: u32 = 1024;
 /// Synthesis parameter `max_octaves` of the description.
@@ -35,7 +35,7 @@ pub mod version {
     /// Byte offset from [`super::BASE_ADDRESS`].
     pub const OFFSET: u16 = 0x00;
     /// Value after reset.
-    pub const RESET: u32 = 0x5C01_0200;
+    pub const RESET: u32 = 0x5C01_0201;
     /// Offset, reset and access masks.
     pub const REGISTER: Register = Register {
         name: "VERSION",
@@ -48,13 +48,13 @@ pub mod version {
         pops_on_read: false,
     };
 
-    /// `[7:0]` ro, reset 0: Register-map minor version (additive changes only).
+    /// `[7:0]` ro, reset 1: Register-map minor version (additive changes only).
     pub const MINOR: Field = Field {
         name: "VERSION.MINOR",
         offset: OFFSET,
         bits: BitRange { lsb: 0, width: 8 },
         access: Access::Ro,
-        reset: 0,
+        reset: 1,
         min: 0,
         max: 255,
     };
@@ -156,7 +156,7 @@ pub mod status {
         pops_on_read: false,
     };
 
-    /// `[0:0]` ro, reset 0: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs.
+    /// `[0:0]` ro, reset 0: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs and, while STREAM_CONTROL.ENABLE is 1, until the stream engine has sent the frame's FrameEnd.
     pub const BUSY: Field = Field {
         name: "STATUS.BUSY",
         offset: OFFSET,
@@ -167,7 +167,7 @@ pub mod status {
         max: 1,
     };
 
-    /// `[1:1]` w1c, reset 0: Set when BUSY falls: every entry of the frame is in the FIFOs.
+    /// `[1:1]` w1c, reset 0: Set when BUSY falls: every entry of the frame is in the FIFOs (or, with the stream engine enabled, sent).
     pub const FRAME_DONE: Field = Field {
         name: "STATUS.FRAME_DONE",
         offset: OFFSET,
@@ -361,7 +361,7 @@ pub mod edge_threshold {
     };
 }
 
-/// Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points. Offset 0x20, rw.
+/// Which scale feeds the Sobel unit, and how the stream engine packs the Sobel stream and the points. Offset 0x20, rw.
 pub mod output_mode {
     use crate::{Access, BitRange, Field, Register};
 
@@ -381,7 +381,7 @@ pub mod output_mode {
         pops_on_read: false,
     };
 
-    /// `[0:0]` rw, reset 1: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
+    /// `[0:0]` rw, reset 1: How the stream engine sends the Sobel stream to the host. The datapath does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
     pub const SOBEL_OUTPUT: Field = Field {
         name: "OUTPUT_MODE.SOBEL_OUTPUT",
         offset: OFFSET,
@@ -396,9 +396,9 @@ pub mod output_mode {
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
     #[repr(u32)]
     pub enum SobelOutput {
-        /// The driver sends every row of every octave (SobelRows packets).
+        /// The stream engine sends every row of every octave (SobelRows packets).
         Rows = 0,
-        /// The driver cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the fabric still streams every pixel.
+        /// The stream engine cuts the 16x16 patch around each point out of the stream of the point's own octave and sends the patches (SobelPatch packets); the datapath still streams every pixel.
         Patches = 1,
     }
 
@@ -432,7 +432,7 @@ pub mod output_mode {
         max: 3,
     };
 
-    /// `[15:8]` rw, reset 16, valid 1..=128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
+    /// `[15:8]` rw, reset 16, valid 1..=128: Most points the stream engine puts in one PointBatch packet (the wire allows 128). A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
     pub const POINTS_PER_BATCH: Field = Field {
         name: "OUTPUT_MODE.POINTS_PER_BATCH",
         offset: OFFSET,
@@ -443,7 +443,7 @@ pub mod output_mode {
         max: 128,
     };
 
-    /// `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+    /// `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
     pub const ROW_SEGMENT: Field = Field {
         name: "OUTPUT_MODE.ROW_SEGMENT",
         offset: OFFSET,
@@ -949,8 +949,354 @@ pub mod max_offset {
     };
 }
 
+/// Stream engine control, sampled at each FRAME_ARM (FEC at each link frame). Offset 0x54, rw.
+pub mod stream_control {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x54;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "STREAM_CONTROL",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0x0000_0000,
+        rw_mask: 0x0000_FF03,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[0:0]` rw, reset 0: 1: the stream engine drains both FIFOs and sends the frame's packets on LINK_OUT. 0: the FIFOs wait for the bus (POINT_FIFO_DATA, SOBEL_FIFO_DATA), as for bring-up and the register contract test; LINK_OUT stays idle.
+    pub const ENABLE: Field = Field {
+        name: "STREAM_CONTROL.ENABLE",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 1 },
+        access: Access::Rw,
+        reset: 0,
+        min: 0,
+        max: 1,
+    };
+
+    /// `[1:1]` rw, reset 0: 1: every link frame the engine sends carries RS(255,239) parity (wire-format.md, Forward error correction). The driver sets it when the host asks for FEC in its Hello.
+    pub const FEC: Field = Field {
+        name: "STREAM_CONTROL.FEC",
+        offset: OFFSET,
+        bits: BitRange { lsb: 1, width: 1 },
+        access: Access::Rw,
+        reset: 0,
+        min: 0,
+        max: 1,
+    };
+
+    /// `[15:8]` rw, reset 0: The camera this channel serves: the packets' camera field and their wire source (1 + CAMERA).
+    pub const CAMERA: Field = Field {
+        name: "STREAM_CONTROL.CAMERA",
+        offset: OFFSET,
+        bits: BitRange { lsb: 8, width: 8 },
+        access: Access::Rw,
+        reset: 0,
+        min: 0,
+        max: 255,
+    };
+}
+
+/// The frame number the next frame's packets carry, latched at FRAME_ARM. Offset 0x58, rw.
+pub mod frame_id {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x58;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "FRAME_ID",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0x0000_0000,
+        rw_mask: 0xFFFF_FFFF,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[31:0]` rw, reset 0: FrameStart.frame_id and every later packet's of the frame; the driver counts frames and writes it before each FRAME_ARM.
+    pub const VALUE: Field = Field {
+        name: "FRAME_ID.VALUE",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 32 },
+        access: Access::Rw,
+        reset: 0,
+        min: 0,
+        max: 4294967295,
+    };
+}
+
+/// Low word of the next frame's capture time, latched at FRAME_ARM. Offset 0x5C, rw.
+pub mod timestamp_lo {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x5C;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "TIMESTAMP_LO",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0x0000_0000,
+        rw_mask: 0xFFFF_FFFF,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[31:0]` rw, reset 0: FrameStart.timestamp_us bits 31..0 (microseconds).
+    pub const VALUE: Field = Field {
+        name: "TIMESTAMP_LO.VALUE",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 32 },
+        access: Access::Rw,
+        reset: 0,
+        min: 0,
+        max: 4294967295,
+    };
+}
+
+/// High word of the next frame's capture time, latched at FRAME_ARM. Offset 0x60, rw.
+pub mod timestamp_hi {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x60;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "TIMESTAMP_HI",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0x0000_0000,
+        rw_mask: 0xFFFF_FFFF,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[31:0]` rw, reset 0: FrameStart.timestamp_us bits 63..32.
+    pub const VALUE: Field = Field {
+        name: "TIMESTAMP_HI.VALUE",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 32 },
+        access: Access::Rw,
+        reset: 0,
+        min: 0,
+        max: 4294967295,
+    };
+}
+
+/// Points the stream engine sent in the current (or last) frame's PointBatch packets: FrameEnd.point_count. Offset 0x64, ro.
+pub mod stream_points {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x64;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "STREAM_POINTS",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0xFFFF_FFFF,
+        rw_mask: 0x0000_0000,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[31:0]` ro, reset 0: Zeroed at FRAME_ARM; saturates.
+    pub const COUNT: Field = Field {
+        name: "STREAM_POINTS.COUNT",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 32 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 4294967295,
+    };
+}
+
+/// SobelRows or SobelPatch packets the stream engine sent in the current (or last) frame: FrameEnd.sobel_count. Offset 0x68, ro.
+pub mod stream_sobel_packets {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x68;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "STREAM_SOBEL_PACKETS",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0xFFFF_FFFF,
+        rw_mask: 0x0000_0000,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[31:0]` ro, reset 0: Zeroed at FRAME_ARM; saturates.
+    pub const COUNT: Field = Field {
+        name: "STREAM_SOBEL_PACKETS.COUNT",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 32 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 4294967295,
+    };
+}
+
+/// Points of the current (or last) frame that got no patch: their top rows had left the engine's row ring, or its queue of waiting points was full. FrameEnd.dropped_sobel adds them to SOBEL_OVERFLOW_COUNT's growth. Offset 0x6C, ro.
+pub mod stream_patches_dropped {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x6C;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "STREAM_PATCHES_DROPPED",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0xFFFF_FFFF,
+        rw_mask: 0x0000_0000,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[31:0]` ro, reset 0: Zeroed at FRAME_ARM; saturates.
+    pub const COUNT: Field = Field {
+        name: "STREAM_PATCHES_DROPPED.COUNT",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 32 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 4294967295,
+    };
+}
+
+/// Why the stream engine stopped sending the current (or last) frame, with the record that stopped it. A frame with a fault gets no FrameEnd; the driver reports the fault to the host. Zeroed at FRAME_ARM. Offset 0x70, ro.
+pub mod stream_fault {
+    use crate::{Access, BitRange, Field, Register};
+
+    /// Byte offset from [`super::BASE_ADDRESS`].
+    pub const OFFSET: u16 = 0x70;
+    /// Value after reset.
+    pub const RESET: u32 = 0x0000_0000;
+    /// Offset, reset and access masks.
+    pub const REGISTER: Register = Register {
+        name: "STREAM_FAULT",
+        offset: OFFSET,
+        reset: RESET,
+        ro_mask: 0x03FF_FFFF,
+        rw_mask: 0x0000_0000,
+        w1c_mask: 0x0000_0000,
+        wo_mask: 0x0000_0000,
+        pops_on_read: false,
+    };
+
+    /// `[1:0]` ro, reset 0: What stopped the frame.
+    pub const CAUSE: Field = Field {
+        name: "STREAM_FAULT.CAUSE",
+        offset: OFFSET,
+        bits: BitRange { lsb: 0, width: 2 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 3,
+    };
+
+    /// Values of [`CAUSE`].
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    #[repr(u32)]
+    pub enum Cause {
+        /// No fault.
+        None = 0,
+        /// A Sobel pixel outside its octave's image or behind a row already complete (a datapath defect).
+        SobelOrder = 1,
+        /// A point outside its octave's image (a datapath defect).
+        PointOutside = 2,
+        /// A packet the framer could not encode (an engine defect: every packet is within the wire limits).
+        Encode = 3,
+    }
+
+    impl Cause {
+        /// The field's code for this value.
+        pub const fn bits(self) -> u32 {
+            self as u32
+        }
+
+        /// The value a code names, if any.
+        pub const fn from_bits(bits: u32) -> Option<Self> {
+            match bits {
+                0 => Some(Self::None),
+                1 => Some(Self::SobelOrder),
+                2 => Some(Self::PointOutside),
+                3 => Some(Self::Encode),
+                _ => None,
+            }
+        }
+    }
+
+    /// [`CAUSE`] after reset.
+    pub const CAUSE_RESET: Cause = Cause::None;
+
+    /// `[3:2]` ro, reset 0: The record's octave.
+    pub const OCTAVE: Field = Field {
+        name: "STREAM_FAULT.OCTAVE",
+        offset: OFFSET,
+        bits: BitRange { lsb: 2, width: 2 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 3,
+    };
+
+    /// `[14:4]` ro, reset 0: The record's column (its low 11 bits).
+    pub const X: Field = Field {
+        name: "STREAM_FAULT.X",
+        offset: OFFSET,
+        bits: BitRange { lsb: 4, width: 11 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 2047,
+    };
+
+    /// `[25:15]` ro, reset 0: The record's row (its low 11 bits).
+    pub const Y: Field = Field {
+        name: "STREAM_FAULT.Y",
+        offset: OFFSET,
+        bits: BitRange { lsb: 15, width: 11 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 2047,
+    };
+}
+
 /// Every register, sorted by offset.
-pub static REGISTERS: [Register; 21] = [
+pub static REGISTERS: [Register; 29] = [
     version::REGISTER,
     control::REGISTER,
     status::REGISTER,
@@ -972,6 +1318,14 @@ pub static REGISTERS: [Register; 21] = [
     sobel_fifo_data::REGISTER,
     sobel_fifo_position::REGISTER,
     max_offset::REGISTER,
+    stream_control::REGISTER,
+    frame_id::REGISTER,
+    timestamp_lo::REGISTER,
+    timestamp_hi::REGISTER,
+    stream_points::REGISTER,
+    stream_sobel_packets::REGISTER,
+    stream_patches_dropped::REGISTER,
+    stream_fault::REGISTER,
 ];
 
 /// Stream ports: signal widths and the bit layout of each DATA word.
@@ -988,5 +1342,15 @@ pub mod ports {
         pub const SOF_WIDTH: u32 = 1;
         /// Width of `EOL` (in): End of line: this pixel is the last of its line. The fabric counts lines by WIDTH and does not check EOL.
         pub const EOL_WIDTH: u32 = 1;
+    }
+
+    /// The stream engine's link frames (COBS bytes, each frame ending in its 0x00 delimiter), one byte per clock, to the link's transmitter. Direction: out of the fabric.
+    pub mod link_out {
+        /// Width of `DATA` (out): A byte of a link frame.
+        pub const DATA_WIDTH: u32 = 8;
+        /// Width of `VALID` (out): DATA holds a byte.
+        pub const VALID_WIDTH: u32 = 1;
+        /// Width of `READY` (in): The transmitter takes the byte on this clock; while it is 0 the engine waits (its FIFOs absorb the datapath's records meanwhile, and count what they cannot hold).
+        pub const READY_WIDTH: u32 = 1;
     }
 }

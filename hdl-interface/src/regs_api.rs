@@ -28,7 +28,7 @@ use crate::{regs, Error, RegisterBus};
 pub trait Registers: RegisterBus {
     // VERSION (offset 0x00): Identifies the fabric and the register-map version it implements.
 
-    /// VERSION.MINOR `[7:0]` ro, reset 0: Register-map minor version (additive changes only).
+    /// VERSION.MINOR `[7:0]` ro, reset 1: Register-map minor version (additive changes only).
     fn version_minor(&mut self) -> u8 {
         self.read_field(&regs::version::MINOR) as u8
     }
@@ -67,12 +67,12 @@ pub trait Registers: RegisterBus {
 
     // STATUS (offset 0x08): Pipeline state and sticky event flags.
 
-    /// STATUS.BUSY `[0:0]` ro, reset 0: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs.
+    /// STATUS.BUSY `[0:0]` ro, reset 0: 1 from an accepted FRAME_ARM until the last point and Sobel entry of that frame are in the FIFOs and, while STREAM_CONTROL.ENABLE is 1, until the stream engine has sent the frame's FrameEnd.
     fn status_busy(&mut self) -> bool {
         self.read_field(&regs::status::BUSY) != 0
     }
 
-    /// STATUS.FRAME_DONE `[1:1]` w1c, reset 0: Set when BUSY falls: every entry of the frame is in the FIFOs.
+    /// STATUS.FRAME_DONE `[1:1]` w1c, reset 0: Set when BUSY falls: every entry of the frame is in the FIFOs (or, with the stream engine enabled, sent).
     fn status_frame_done(&mut self) -> bool {
         self.read_field(&regs::status::FRAME_DONE) != 0
     }
@@ -162,9 +162,9 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::edge_threshold::R, u32::from(value))
     }
 
-    // OUTPUT_MODE (offset 0x20): Which scale feeds the Sobel unit, and how the soft-core packs the Sobel stream and the points.
+    // OUTPUT_MODE (offset 0x20): Which scale feeds the Sobel unit, and how the stream engine packs the Sobel stream and the points.
 
-    /// OUTPUT_MODE.SOBEL_OUTPUT `[0:0]` rw, reset 1: How the soft-core driver sends the Sobel stream to the host. The fabric does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
+    /// OUTPUT_MODE.SOBEL_OUTPUT `[0:0]` rw, reset 1: How the stream engine sends the Sobel stream to the host. The datapath does not read this field: it always pushes every Sobel pixel of every octave into the Sobel FIFO.
     fn output_mode_sobel_output(&mut self) -> regs::output_mode::SobelOutput {
         match self.read_field(&regs::output_mode::SOBEL_OUTPUT) {
             0 => regs::output_mode::SobelOutput::Rows,
@@ -187,7 +187,7 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::output_mode::SOBEL_SCALE, u32::from(value))
     }
 
-    /// OUTPUT_MODE.POINTS_PER_BATCH `[15:8]` rw, reset 16, valid 1..=128: Most points the driver puts in one PointBatch packet (the wire allows 128). The fabric does not read this field. A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
+    /// OUTPUT_MODE.POINTS_PER_BATCH `[15:8]` rw, reset 16, valid 1..=128: Most points the stream engine puts in one PointBatch packet (the wire allows 128). A damaged packet costs the points it carries, so a noisy link wants small batches; each packet adds about 20 bytes of header, CRC and framing to the 14 bytes per point, so a clean link wants large ones. The reset value, 16, spends 8 % of the point stream on overhead, and a damaged packet costs 16 points: under a tenth of the 200 to 500 points a frame of 320x240 to 640x480 carries, which a salvaged frame may lose (docs: wire-format.md, Salvage).
     fn output_mode_points_per_batch(&mut self) -> u8 {
         self.read_field(&regs::output_mode::POINTS_PER_BATCH) as u8
     }
@@ -197,7 +197,7 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::output_mode::POINTS_PER_BATCH, u32::from(value))
     }
 
-    /// OUTPUT_MODE.ROW_SEGMENT `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the driver puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). The fabric does not read this field. A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+    /// OUTPUT_MODE.ROW_SEGMENT `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
     fn output_mode_row_segment(&mut self) -> u16 {
         self.read_field(&regs::output_mode::ROW_SEGMENT) as u16
     }
@@ -309,6 +309,122 @@ pub trait Registers: RegisterBus {
     /// Writes MAX_OFFSET.VALUE (`[15:0]` rw, reset 0x1000, valid 0..=8191); see [`Self::max_offset_value`].
     fn set_max_offset_value(&mut self, value: u16) -> Result<(), Error> {
         self.write_field(&regs::max_offset::VALUE, u32::from(value))
+    }
+
+    // STREAM_CONTROL (offset 0x54): Stream engine control, sampled at each FRAME_ARM (FEC at each link frame).
+
+    /// STREAM_CONTROL.ENABLE `[0:0]` rw, reset 0: 1: the stream engine drains both FIFOs and sends the frame's packets on LINK_OUT. 0: the FIFOs wait for the bus (POINT_FIFO_DATA, SOBEL_FIFO_DATA), as for bring-up and the register contract test; LINK_OUT stays idle.
+    fn stream_control_enable(&mut self) -> bool {
+        self.read_field(&regs::stream_control::ENABLE) != 0
+    }
+
+    /// Writes STREAM_CONTROL.ENABLE (`[0:0]` rw, reset 0); see [`Self::stream_control_enable`].
+    fn set_stream_control_enable(&mut self, value: bool) -> Result<(), Error> {
+        self.write_field(&regs::stream_control::ENABLE, u32::from(value))
+    }
+
+    /// STREAM_CONTROL.FEC `[1:1]` rw, reset 0: 1: every link frame the engine sends carries RS(255,239) parity (wire-format.md, Forward error correction). The driver sets it when the host asks for FEC in its Hello.
+    fn stream_control_fec(&mut self) -> bool {
+        self.read_field(&regs::stream_control::FEC) != 0
+    }
+
+    /// Writes STREAM_CONTROL.FEC (`[1:1]` rw, reset 0); see [`Self::stream_control_fec`].
+    fn set_stream_control_fec(&mut self, value: bool) -> Result<(), Error> {
+        self.write_field(&regs::stream_control::FEC, u32::from(value))
+    }
+
+    /// STREAM_CONTROL.CAMERA `[15:8]` rw, reset 0: The camera this channel serves: the packets' camera field and their wire source (1 + CAMERA).
+    fn stream_control_camera(&mut self) -> u8 {
+        self.read_field(&regs::stream_control::CAMERA) as u8
+    }
+
+    /// Writes STREAM_CONTROL.CAMERA (`[15:8]` rw, reset 0); see [`Self::stream_control_camera`].
+    fn set_stream_control_camera(&mut self, value: u8) -> Result<(), Error> {
+        self.write_field(&regs::stream_control::CAMERA, u32::from(value))
+    }
+
+    // FRAME_ID (offset 0x58): The frame number the next frame's packets carry, latched at FRAME_ARM.
+
+    /// FRAME_ID.VALUE `[31:0]` rw, reset 0: FrameStart.frame_id and every later packet's of the frame; the driver counts frames and writes it before each FRAME_ARM.
+    fn frame_id_value(&mut self) -> u32 {
+        self.read_field(&regs::frame_id::VALUE)
+    }
+
+    /// Writes FRAME_ID.VALUE (`[31:0]` rw, reset 0); see [`Self::frame_id_value`].
+    fn set_frame_id_value(&mut self, value: u32) -> Result<(), Error> {
+        self.write_field(&regs::frame_id::VALUE, value)
+    }
+
+    // TIMESTAMP_LO (offset 0x5C): Low word of the next frame's capture time, latched at FRAME_ARM.
+
+    /// TIMESTAMP_LO.VALUE `[31:0]` rw, reset 0: FrameStart.timestamp_us bits 31..0 (microseconds).
+    fn timestamp_lo_value(&mut self) -> u32 {
+        self.read_field(&regs::timestamp_lo::VALUE)
+    }
+
+    /// Writes TIMESTAMP_LO.VALUE (`[31:0]` rw, reset 0); see [`Self::timestamp_lo_value`].
+    fn set_timestamp_lo_value(&mut self, value: u32) -> Result<(), Error> {
+        self.write_field(&regs::timestamp_lo::VALUE, value)
+    }
+
+    // TIMESTAMP_HI (offset 0x60): High word of the next frame's capture time, latched at FRAME_ARM.
+
+    /// TIMESTAMP_HI.VALUE `[31:0]` rw, reset 0: FrameStart.timestamp_us bits 63..32.
+    fn timestamp_hi_value(&mut self) -> u32 {
+        self.read_field(&regs::timestamp_hi::VALUE)
+    }
+
+    /// Writes TIMESTAMP_HI.VALUE (`[31:0]` rw, reset 0); see [`Self::timestamp_hi_value`].
+    fn set_timestamp_hi_value(&mut self, value: u32) -> Result<(), Error> {
+        self.write_field(&regs::timestamp_hi::VALUE, value)
+    }
+
+    // STREAM_POINTS (offset 0x64): Points the stream engine sent in the current (or last) frame's PointBatch packets: FrameEnd.point_count.
+
+    /// STREAM_POINTS.COUNT `[31:0]` ro, reset 0: Zeroed at FRAME_ARM; saturates.
+    fn stream_points_count(&mut self) -> u32 {
+        self.read_field(&regs::stream_points::COUNT)
+    }
+
+    // STREAM_SOBEL_PACKETS (offset 0x68): SobelRows or SobelPatch packets the stream engine sent in the current (or last) frame: FrameEnd.sobel_count.
+
+    /// STREAM_SOBEL_PACKETS.COUNT `[31:0]` ro, reset 0: Zeroed at FRAME_ARM; saturates.
+    fn stream_sobel_packets_count(&mut self) -> u32 {
+        self.read_field(&regs::stream_sobel_packets::COUNT)
+    }
+
+    // STREAM_PATCHES_DROPPED (offset 0x6C): Points of the current (or last) frame that got no patch: their top rows had left the engine's row ring, or its queue of waiting points was full. FrameEnd.dropped_sobel adds them to SOBEL_OVERFLOW_COUNT's growth.
+
+    /// STREAM_PATCHES_DROPPED.COUNT `[31:0]` ro, reset 0: Zeroed at FRAME_ARM; saturates.
+    fn stream_patches_dropped_count(&mut self) -> u32 {
+        self.read_field(&regs::stream_patches_dropped::COUNT)
+    }
+
+    // STREAM_FAULT (offset 0x70): Why the stream engine stopped sending the current (or last) frame, with the record that stopped it. A frame with a fault gets no FrameEnd; the driver reports the fault to the host. Zeroed at FRAME_ARM.
+
+    /// STREAM_FAULT.CAUSE `[1:0]` ro, reset 0: What stopped the frame.
+    fn stream_fault_cause(&mut self) -> regs::stream_fault::Cause {
+        match self.read_field(&regs::stream_fault::CAUSE) {
+            0 => regs::stream_fault::Cause::None,
+            1 => regs::stream_fault::Cause::SobelOrder,
+            2 => regs::stream_fault::Cause::PointOutside,
+            _ => regs::stream_fault::Cause::Encode,
+        }
+    }
+
+    /// STREAM_FAULT.OCTAVE `[3:2]` ro, reset 0: The record's octave.
+    fn stream_fault_octave(&mut self) -> u8 {
+        self.read_field(&regs::stream_fault::OCTAVE) as u8
+    }
+
+    /// STREAM_FAULT.X `[14:4]` ro, reset 0: The record's column (its low 11 bits).
+    fn stream_fault_x(&mut self) -> u16 {
+        self.read_field(&regs::stream_fault::X) as u16
+    }
+
+    /// STREAM_FAULT.Y `[25:15]` ro, reset 0: The record's row (its low 11 bits).
+    fn stream_fault_y(&mut self) -> u16 {
+        self.read_field(&regs::stream_fault::Y) as u16
     }
 }
 

@@ -173,13 +173,19 @@ fn qemu_instructions_per_pixel_640x240_are_deterministic() {
         kernels.per_pixel(kernels.sobel_cordic)
     );
     for (a, b) in first.iter().zip(&second) {
-        assert_eq!(a.front_end, b.front_end, "front-end counts of two runs");
-        // The driver's count carries a few instructions around each UART wait, and how
-        // often the transmitter is busy depends on how fast the host reads: on an idle
-        // machine two runs differ by tens of instructions in 53 million, under a loaded CI
-        // run by thousands (1.1e-4 seen). 1e-3 still pins the per-pixel figure to ±0.35.
-        let spread = a.driver.abs_diff(b.driver) as f64 / a.driver as f64;
-        assert!(spread < 1e-3, "driver counts {} and {}", a.driver, b.driver);
+        assert_eq!(a.driver, b.driver, "driver counts of two runs");
+        // The stream engine's stand-in writes the UART, so the front end's count carries a
+        // few instructions around each wait for the transmitter, and how often it is busy
+        // depends on how fast the host reads: two runs differ by thousands of instructions
+        // in tens of millions under a loaded CI run. 1e-3 still pins the per-pixel figure to
+        // a few tenths.
+        let spread = a.front_end.abs_diff(b.front_end) as f64 / a.front_end as f64;
+        assert!(
+            spread < 1e-3,
+            "front-end counts {} and {}",
+            a.front_end,
+            b.front_end
+        );
     }
     for r in &first {
         assert_eq!(r.pixels, 640 * 240);

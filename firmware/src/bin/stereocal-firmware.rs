@@ -9,7 +9,8 @@
 //!    stream is byte for byte what the in-process device sends (apart from the `LOG`
 //!    capability bit in that `Hello`).
 //! 3. For every frame of the input, left then right image: the driver runs the image through
-//!    the fabric's device model, on its registers and PIXEL_IN port, and sends its packets. Host packets waiting between frames are
+//!    the fabric's device model, on its registers and PIXEL_IN port, and the model's stream
+//!    engine sends the frame's packets on the UART. Host packets waiting between frames are
 //!    answered; clearing `CONTROL.ENABLE` pauses before the next frame. With
 //!    `FLAG_COUNT_INSTRUCTIONS` each image's instruction counts follow as a log packet, and
 //!    after the last frame the row kernels' counts on the first image
@@ -36,8 +37,9 @@ fn main() {
 
 #[cfg(target_os = "none")]
 mod soft_core {
-    use stereocal_firmware::driver::{Driver, DriverError, PacketWriter};
+    use stereocal_firmware::driver::{Driver, DriverError};
     use stereocal_firmware::fabric::{FabricDevice, FabricModel};
+    use stereocal_firmware::framing::PacketWriter;
     use stereocal_firmware::softcore::finisher::{self, ExitCode};
     use stereocal_firmware::softcore::frame_input::{
         FrameInput, InputHeader, FLAG_AUTOSTART, FLAG_COUNT_INSTRUCTIONS, FLAG_REGISTER_MODEL,
@@ -54,9 +56,10 @@ mod soft_core {
     };
 
     /// One camera channel: the driver, on the registers and PIXEL_IN port of the fabric's
-    /// device model (everything the model does counted in instructions). The driver reaches
-    /// it only through the register bus, as it would reach a fabric's registers by MMIO.
-    type Channel = Driver<CountedFabric<FabricDevice<FabricModel>>>;
+    /// device model (everything the model does counted in instructions), whose stream engine
+    /// sends on the UART as the fabric's LINK_OUT would. The driver reaches it only through
+    /// the register bus, as it would reach a fabric's registers by MMIO.
+    type Channel = Driver<CountedFabric<FabricDevice<FabricModel, 1280, Uart0>>>;
 
     /// Host packets are short (a RegisterWrite is 16 framed bytes); a longer frame is refused.
     type HostAccumulator = Accumulator<64>;
@@ -98,7 +101,7 @@ mod soft_core {
         } else {
             FabricModel::fast()
         };
-        let fabric = CountedFabric::new(FabricDevice::new(model));
+        let fabric = CountedFabric::new(FabricDevice::with_link(model, Uart0::new()));
         let mut channel = Driver::new(fabric, camera).with_capabilities(Capabilities::LOG);
         let bus = channel.bus_mut();
         let geometry = bus
@@ -154,6 +157,16 @@ mod soft_core {
                         let (code, detail) = e.report();
                         report(code, detail);
                     }
+                    if let PacketRepr::Hello(_) = packet {
+                        // Every channel's frames share the link the Hello set up.
+                        let fec = with_link(|link| link.fec());
+                        for other in others.iter_mut() {
+                            if let Err(e) = other.set_fec(fec) {
+                                let (code, detail) = e.report();
+                                report(code, detail);
+                            }
+                        }
+                    }
                 }
             }
         }
@@ -204,15 +217,18 @@ mod soft_core {
                     stop(ExitCode::BadInput);
                 };
                 channel.bus().take();
+                channel.bus_mut().inner_mut().link_mut().take_waited();
                 with_link(|link| link.sink_mut().take_waited());
                 let start = instructions::instret();
-                let result =
-                    with_link(|link| channel.process_frame(image.pixels, image.timestamp_us, link));
+                let result = channel.process_frame(image.pixels, image.timestamp_us);
                 let spent = instructions::instret().wrapping_sub(start);
+                // The stream engine's waits for the transmitter are inside the fabric's count.
+                let link_wait = channel.bus_mut().inner_mut().link_mut().take_waited();
                 match result {
                     Ok(summary) if header.has_flag(FLAG_COUNT_INSTRUCTIONS) => {
-                        let front_end = channel.bus().take();
-                        let uart_wait = with_link(|link| link.sink_mut().take_waited());
+                        let front_end = channel.bus().take().wrapping_sub(link_wait);
+                        let uart_wait =
+                            with_link(|link| link.sink_mut().take_waited()).wrapping_add(link_wait);
                         instructions::log(&InstructionReport {
                             frame: summary.frame_id,
                             camera: camera as u8,

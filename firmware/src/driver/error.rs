@@ -5,7 +5,7 @@ use core::fmt;
 use stereocal_hdl::regs;
 use stereocal_wire::{ErrorCode, FrameFailure};
 
-use crate::driver::sobel_ring::OutOfOrder;
+use crate::fabric::stream::OutOfOrder;
 use crate::fabric::{ConfigError, FrameError};
 
 /// Why the driver could not configure the fabric or process a frame.
@@ -31,10 +31,11 @@ pub enum DriverError {
         /// The ring's width.
         max: usize,
     },
-    /// The fabric emitted a Sobel pixel outside its octave's image or out of raster order
-    /// (a fabric model defect).
+    /// The fabric's stream engine stopped the frame at a Sobel pixel outside its octave's
+    /// image or out of raster order (a datapath defect; STREAM_FAULT).
     SobelOutOfOrder(OutOfOrder),
-    /// The fabric emitted a point outside its octave's image (a fabric model defect).
+    /// The fabric's stream engine stopped the frame at a point outside its octave's image (a
+    /// datapath defect; STREAM_FAULT).
     PointOutOfFrame {
         /// The point's octave.
         octave: u8,
@@ -43,9 +44,12 @@ pub enum DriverError {
         /// Its row.
         y: u16,
     },
-    /// A packet could not be encoded (a driver defect: every packet is built within the wire
-    /// format's limits).
+    /// An answer to the host could not be encoded (a driver defect: every packet is built
+    /// within the wire format's limits).
     Encode(stereocal_wire::Error),
+    /// The fabric's stream engine stopped the frame at a packet its framer refused (an engine
+    /// defect; STREAM_FAULT).
+    StreamEncode,
     /// The fabric did not take FRAME_ARM: STATUS.BUSY stayed 0.
     NotArmed,
 }
@@ -82,7 +86,7 @@ impl DriverError {
             Self::TooWide { width, .. } => (FrameFailure::TooWide, u32::from(width)),
             Self::SobelOutOfOrder(p) => (FrameFailure::SobelOutOfOrder, u32::from(p.y)),
             Self::PointOutOfFrame { y, .. } => (FrameFailure::PointOutOfFrame, u32::from(y)),
-            Self::Encode(_) => (FrameFailure::Encode, 0),
+            Self::Encode(_) | Self::StreamEncode => (FrameFailure::Encode, 0),
             Self::NotArmed => (FrameFailure::NotArmed, 0),
         };
         cause.detail(value)
@@ -121,14 +125,15 @@ impl fmt::Display for DriverError {
             }
             Self::SobelOutOfOrder(p) => write!(
                 f,
-                "fabric emitted Sobel pixel ({}, {}) of octave {} out of raster order or outside the image",
+                "the stream engine stopped at Sobel pixel ({}, {}) of octave {}: out of raster order or outside the image",
                 p.x, p.y, p.octave
             ),
             Self::PointOutOfFrame { octave, x, y } => write!(
                 f,
-                "fabric emitted point ({x}, {y}) outside octave {octave}'s image"
+                "the stream engine stopped at point ({x}, {y}) outside octave {octave}'s image"
             ),
             Self::Encode(e) => write!(f, "packet encoding: {e}"),
+            Self::StreamEncode => write!(f, "the stream engine could not encode a packet"),
             Self::NotArmed => write!(f, "the fabric did not take FRAME_ARM (STATUS.BUSY stayed 0)"),
         }
     }

@@ -19,11 +19,12 @@ use stereocal_wire::{
 use super::*;
 use crate::fabric::geometry::octave_dims;
 use crate::fabric::refine::Offset;
-use crate::fabric::sobel_fifo::SobelFifo;
+use crate::fabric::stream::{wire_point, OutOfOrder, MAX_PENDING, RING_ROWS};
 use crate::fabric::{
     Config, ConfigError, Extremum, FabricDevice, FabricModel, FrameError, FrontEnd, Overflow,
     SobelEntry, SobelRun,
 };
+use crate::framing::{ByteSink, PacketWriter};
 
 /// A sink that keeps every byte.
 #[derive(Default)]
@@ -33,6 +34,31 @@ impl ByteSink for Collect {
     fn write(&mut self, bytes: &[u8]) {
         self.0.extend_from_slice(bytes);
     }
+}
+
+/// A device whose stream engine's link is a [`Collect`].
+trait Collected {
+    /// Takes what the link collected.
+    fn take_sent(&mut self) -> Vec<u8>;
+}
+
+impl<F: FrontEnd, const W0: usize> Collected for FabricDevice<F, W0, Collect> {
+    fn take_sent(&mut self) -> Vec<u8> {
+        core::mem::take(&mut self.link_mut().0)
+    }
+}
+
+impl<D: Collected> Collected for Watched<D> {
+    fn take_sent(&mut self) -> Vec<u8> {
+        self.device.take_sent()
+    }
+}
+
+/// What the driver's fabric sent on its link since the last call.
+fn sent<B: RegisterBus + PixelIn + Collected, const W0: usize>(
+    driver: &mut Driver<B, W0>,
+) -> Vec<u8> {
+    driver.bus_mut().take_sent()
 }
 
 /// A decoded packet, owned.
@@ -286,9 +312,9 @@ impl FrontEnd for Scripted {
     }
 }
 
-type ScriptedDriver = Driver<Watched<FabricDevice<Scripted, 64>>, 64>;
+type ScriptedDriver = Driver<Watched<FabricDevice<Scripted, 64, Collect>>, 64>;
 
-/// A fabric's bus as an MMIO bus is: every burst read word by word. It also counts accesses to
+/// A fabric's bus as an MMIO bus is: every burst read word by word. It counts accesses to
 /// offsets where no register lives.
 struct Watched<D> {
     device: D,
@@ -334,7 +360,7 @@ impl<D: PixelIn> PixelIn for Watched<D> {
 
 fn scripted_driver(script: Scripted, config: &FabricConfig) -> std::boxed::Box<ScriptedDriver> {
     let mut driver = std::boxed::Box::new(Driver::new(
-        Watched::new(FabricDevice::new(script)),
+        Watched::new(FabricDevice::with_link(script, Collect::default())),
         Camera::Right,
     ));
     driver.configure(config).expect("valid configuration");
@@ -387,15 +413,14 @@ fn frame_packets_come_in_order_with_consecutive_sequence_numbers_of_their_channe
         ..Scripted::default()
     };
     let mut driver = scripted_driver(script, &SMALL);
-    let mut link = PacketWriter::new(Collect::default());
     let image = vec![0u8; 48 * 40];
-    let first = driver.process_frame(&image, 1234, &mut link).unwrap();
-    let second = driver.process_frame(&image, 5678, &mut link).unwrap();
+    let first = driver.process_frame(&image, 1234).unwrap();
+    let second = driver.process_frame(&image, 5678).unwrap();
     assert_eq!((first.frame_id, second.frame_id), (0, 1));
     assert_eq!(first.points, 2);
     assert_eq!(first.sobel_packets, 2);
 
-    let packets = decode_all(&link.sink().0);
+    let packets = decode_all(&sent(&mut driver));
     let per_frame = packets.len() / 2;
     assert_eq!(
         packets[0],
@@ -478,11 +503,8 @@ fn rows_mode_sends_every_row_of_every_octave_once() {
         ..SMALL
     };
     let mut driver = scripted_driver(Scripted::default(), &config);
-    let mut link = PacketWriter::new(Collect::default());
-    let summary = driver
-        .process_frame(&vec![0u8; 48 * 40], 0, &mut link)
-        .unwrap();
-    let packets = decode_all(&link.sink().0);
+    let summary = driver.process_frame(&vec![0u8; 48 * 40], 0).unwrap();
+    let packets = decode_all(&sent(&mut driver));
     let mut seen = Vec::new();
     for p in &packets {
         if let Packet::Row {
@@ -539,12 +561,9 @@ fn patches_at_the_borders_are_zero_outside_the_image() {
         ..Scripted::default()
     };
     let mut driver = scripted_driver(script, &config);
-    let mut link = PacketWriter::new(Collect::default());
-    let summary = driver
-        .process_frame(&vec![0u8; 48 * 36], 0, &mut link)
-        .unwrap();
+    let summary = driver.process_frame(&vec![0u8; 48 * 36], 0).unwrap();
     assert_eq!(summary.patches_dropped, 0);
-    let patches: Vec<_> = decode_all(&link.sink().0)
+    let patches: Vec<_> = decode_all(&sent(&mut driver))
         .into_iter()
         .filter_map(|p| match p {
             Packet::Patch {
@@ -581,10 +600,7 @@ fn fifo_overflow_is_counted_and_flagged() {
         ..Scripted::default()
     };
     let mut driver = scripted_driver(script, &SMALL);
-    let mut link = PacketWriter::new(Collect::default());
-    let summary = driver
-        .process_frame(&vec![0u8; 48 * 40], 0, &mut link)
-        .unwrap();
+    let summary = driver.process_frame(&vec![0u8; 48 * 40], 0).unwrap();
     assert_eq!(
         summary.overflow,
         Overflow {
@@ -592,7 +608,7 @@ fn fifo_overflow_is_counted_and_flagged() {
             sobel: 4
         }
     );
-    let packets = decode_all(&link.sink().0);
+    let packets = decode_all(&sent(&mut driver));
     let Some(Packet::End(end)) = packets.last() else {
         panic!()
     };
@@ -621,12 +637,9 @@ fn rows_whose_pixels_were_all_dropped_are_not_sent() {
         ..Scripted::default()
     };
     let mut driver = scripted_driver(script, &config);
-    let mut link = PacketWriter::new(Collect::default());
-    let summary = driver
-        .process_frame(&vec![0u8; 48 * 40], 0, &mut link)
-        .unwrap();
+    let summary = driver.process_frame(&vec![0u8; 48 * 40], 0).unwrap();
     assert_eq!(summary.sobel_packets, 39);
-    let packets = decode_all(&link.sink().0);
+    let packets = decode_all(&sent(&mut driver));
     assert!(!packets
         .iter()
         .any(|p| matches!(p, Packet::Row { row: 7, .. })));
@@ -649,14 +662,11 @@ fn points_too_late_for_the_ring_or_the_queue_are_counted() {
         ..Scripted::default()
     };
     let mut driver = scripted_driver(script, &SMALL);
-    let mut link = PacketWriter::new(Collect::default());
-    let summary = driver
-        .process_frame(&vec![0u8; 48 * 40], 0, &mut link)
-        .unwrap();
+    let summary = driver.process_frame(&vec![0u8; 48 * 40], 0).unwrap();
     assert_eq!(summary.points, MAX_PENDING as u32 + 6);
     assert_eq!(summary.patches_dropped, 1 + 5);
     assert_eq!(summary.sobel_packets, MAX_PENDING as u32);
-    let packets = decode_all(&link.sink().0);
+    let packets = decode_all(&sent(&mut driver));
     let Some(Packet::End(end)) = packets.last() else {
         panic!()
     };
@@ -766,9 +776,8 @@ fn host_packets_are_answered() {
 #[test]
 fn bad_configuration_or_image_sends_nothing() {
     let mut driver = scripted_driver(Scripted::default(), &SMALL);
-    let mut link = PacketWriter::new(Collect::default());
     assert_eq!(
-        driver.process_frame(&[0u8; 10], 0, &mut link),
+        driver.process_frame(&[0u8; 10], 0),
         Err(DriverError::ImageSize {
             expected: 48 * 40,
             got: 10
@@ -776,9 +785,7 @@ fn bad_configuration_or_image_sends_nothing() {
     );
     // Width 49 is not a multiple of 2, as two octaves need.
     driver.bus_mut().write(regs::width::OFFSET, 49);
-    let err = driver
-        .process_frame(&vec![0u8; 49 * 40], 0, &mut link)
-        .unwrap_err();
+    let err = driver.process_frame(&vec![0u8; 49 * 40], 0).unwrap_err();
     assert!(matches!(
         err,
         DriverError::Registers(stereocal_hdl::Error::FrameNotDivisible { .. })
@@ -789,10 +796,10 @@ fn bad_configuration_or_image_sends_nothing() {
     );
     driver.bus_mut().write(regs::width::OFFSET, 96);
     assert!(matches!(
-        driver.process_frame(&vec![0u8; 96 * 40], 0, &mut link),
+        driver.process_frame(&vec![0u8; 96 * 40], 0),
         Err(DriverError::TooWide { width: 96, max: 64 })
     ));
-    assert!(link.sink().0.is_empty());
+    assert!(sent(&mut driver).is_empty());
     assert_eq!(driver.next_frame_id(), 0, "refused frames take no number");
 }
 
@@ -842,15 +849,12 @@ fn a_fabric_emitting_out_of_order_is_an_error() {
             self.0.drain_sobel(max, sink)
         }
     }
-    let mut driver: Driver<FabricDevice<Backwards, 64>, 64> = Driver::new(
-        FabricDevice::new(Backwards(Scripted::default())),
+    let mut driver: Driver<FabricDevice<Backwards, 64, Collect>, 64> = Driver::new(
+        FabricDevice::with_link(Backwards(Scripted::default()), Collect::default()),
         Camera::Left,
     );
     driver.configure(&SMALL).unwrap();
-    let mut link = PacketWriter::new(Collect::default());
-    let err = driver
-        .process_frame(&vec![0u8; 48 * 40], 0, &mut link)
-        .unwrap_err();
+    let err = driver.process_frame(&vec![0u8; 48 * 40], 0).unwrap_err();
     assert_eq!(
         err,
         DriverError::SobelOutOfOrder(OutOfOrder {
@@ -969,18 +973,18 @@ fn fast_path_points_and_patches_match_its_sobel_images() {
     let image = blob_image(160, 120, 11);
     let reference = reference(&TEXTURED, &image);
     assert!(reference.points.len() >= 10, "the test image has features");
-    let mut driver: std::boxed::Box<Driver<FabricDevice<FabricModel<160, 80, 40, 20>, 160>, 160>> =
-        std::boxed::Box::new(Driver::new(
-            FabricDevice::new(FabricModel::fast()),
-            Camera::Left,
-        ));
+    let mut driver: std::boxed::Box<
+        Driver<FabricDevice<FabricModel<160, 80, 40, 20>, 160, Collect>, 160>,
+    > = std::boxed::Box::new(Driver::new(
+        FabricDevice::with_link(FabricModel::fast(), Collect::default()),
+        Camera::Left,
+    ));
     driver.configure(&TEXTURED).unwrap();
-    let mut link = PacketWriter::new(Collect::default());
-    let summary = driver.process_frame(&image, 0, &mut link).unwrap();
+    let summary = driver.process_frame(&image, 0).unwrap();
     assert_eq!(summary.patches_dropped, 0);
     assert_eq!(summary.points as usize, reference.points.len());
 
-    let packets = decode_all(&link.sink().0);
+    let packets = decode_all(&sent(&mut driver));
     let sent: Vec<Point> = packets
         .iter()
         .filter_map(|p| match p {
@@ -989,11 +993,7 @@ fn fast_path_points_and_patches_match_its_sobel_images() {
         })
         .flatten()
         .collect();
-    let expected: Vec<Point> = reference
-        .points
-        .iter()
-        .map(point_batch::wire_point)
-        .collect();
+    let expected: Vec<Point> = reference.points.iter().map(wire_point).collect();
     assert_eq!(sent, expected);
     let mut patched = vec![false; sent.len()];
     for p in &packets {
@@ -1029,16 +1029,16 @@ fn fast_path_rows_are_its_sobel_images() {
     };
     let image = blob_image(160, 120, 5);
     let reference = reference(&config, &image);
-    let mut driver: std::boxed::Box<Driver<FabricDevice<FabricModel<160, 80, 40, 20>, 160>, 160>> =
-        std::boxed::Box::new(Driver::new(
-            FabricDevice::new(FabricModel::fast()),
-            Camera::Left,
-        ));
+    let mut driver: std::boxed::Box<
+        Driver<FabricDevice<FabricModel<160, 80, 40, 20>, 160, Collect>, 160>,
+    > = std::boxed::Box::new(Driver::new(
+        FabricDevice::with_link(FabricModel::fast(), Collect::default()),
+        Camera::Left,
+    ));
     driver.configure(&config).unwrap();
-    let mut link = PacketWriter::new(Collect::default());
-    driver.process_frame(&image, 0, &mut link).unwrap();
+    driver.process_frame(&image, 0).unwrap();
     let mut rows = 0;
-    for p in decode_all(&link.sink().0) {
+    for p in decode_all(&sent(&mut driver)) {
         if let Packet::Row {
             octave,
             row,
@@ -1071,169 +1071,16 @@ fn register_level_model_sends_the_same_bytes_as_the_fast_path() {
         FabricModel::<64, 32, 16, 12>::fast(),
         FabricModel::register_level(),
     ] {
-        let mut driver: std::boxed::Box<Driver<FabricDevice<FabricModel<64, 32, 16, 12>, 64>, 64>> =
-            std::boxed::Box::new(Driver::new(FabricDevice::new(model), Camera::Left));
+        let mut driver: std::boxed::Box<
+            Driver<FabricDevice<FabricModel<64, 32, 16, 12>, 64, Collect>, 64>,
+        > = std::boxed::Box::new(Driver::new(
+            FabricDevice::with_link(model, Collect::default()),
+            Camera::Left,
+        ));
         driver.configure(&config).unwrap();
-        let mut link = PacketWriter::new(Collect::default());
-        let summary = driver.process_frame(&image, 0, &mut link).unwrap();
+        let summary = driver.process_frame(&image, 0).unwrap();
         assert!(summary.points > 0);
-        results.push(link.sink().0.clone());
+        results.push(sent(&mut driver));
     }
     assert_eq!(results[0], results[1]);
-}
-
-/// The bytes a driver on `fabric` sends for `image`.
-fn wire_bytes<D: RegisterBus + PixelIn, const W0: usize>(
-    fabric: D,
-    config: &FabricConfig,
-    image: &[u8],
-) -> Vec<u8> {
-    let mut driver: std::boxed::Box<Driver<D, W0>> =
-        std::boxed::Box::new(Driver::new(fabric, Camera::Left));
-    driver.configure(config).unwrap();
-    let mut link = PacketWriter::new(Collect::default());
-    driver.process_frame(image, 0, &mut link).unwrap();
-    link.sink().0.clone()
-}
-
-/// The device's bursts serve the words a word-by-word bus reads, so the bytes are the same.
-#[test]
-fn bursts_send_the_same_bytes_as_word_by_word_reads() {
-    let image = blob_image(160, 120, 5);
-    for mode in [SobelOutput::Rows, SobelOutput::Patches] {
-        let config = FabricConfig {
-            sobel_output: mode,
-            ..TEXTURED
-        };
-        let fast = || FabricDevice::<_, 160>::new(FabricModel::<160, 80, 40, 20>::fast());
-        let bulk = wire_bytes::<_, 160>(fast(), &config, &image);
-        let single = wire_bytes::<_, 160>(Watched::new(fast()), &config, &image);
-        assert_eq!(bulk, single, "{mode:?}");
-
-        // Dropped pixels: at a row's start, inside it, at its end, and whole rows.
-        let config = FabricConfig {
-            sobel_output: mode,
-            ..SMALL
-        };
-        let mut drop = vec![(0, 47, 3), (0, 0, 12), (0, 1, 12), (1, 10, 2), (1, 23, 5)];
-        drop.extend((0..48).map(|x| (0, x, 7)));
-        drop.extend((0..24).map(|x| (1, x, 19)));
-        let script = || Scripted {
-            points: vec![(14, extremum(0, 2, 12)), (30, extremum(1, 9, 4))],
-            drop: drop.clone(),
-            ..Scripted::default()
-        };
-        let image = vec![0u8; 48 * 40];
-        let device = || FabricDevice::<_, 64>::new(script());
-        let bulk = wire_bytes::<_, 64>(device(), &config, &image);
-        let single = wire_bytes::<_, 64>(Watched::new(device()), &config, &image);
-        assert_eq!(bulk, single, "{mode:?}, dropped pixels");
-    }
-}
-
-#[test]
-fn push_run_reports_what_pixel_by_pixel_pushes_report() {
-    let px = |octave: u8, x: u16, y: u16| SobelEntry {
-        octave,
-        orientation: (x % 64) as u8,
-        magnitude: (y % 251) as u8 + 1,
-        x,
-        y,
-    };
-    // Octave 0 is 20 wide, octave 1 is 10 wide: whole rows, rows with gaps, octaves
-    // interleaved mid-row, a skipped row, an octave the frame lacks, columns going back, a row
-    // gone by and a column past the edge.
-    let mut stream: Vec<SobelEntry> = (0..20).map(|x| px(0, x, 0)).collect();
-    stream.extend((0..6).map(|x| px(1, x, 0)));
-    stream.extend((0..20).filter(|&x| x != 9).map(|x| px(0, x, 1)));
-    stream.extend((6..10).map(|x| px(1, x, 0)));
-    stream.extend((3..19).map(|x| px(0, x, 2)));
-    stream.extend((0..20).map(|x| px(0, x, 4)));
-    stream.extend((5..8).map(|x| px(0, x, 5)));
-    stream.push(px(2, 0, 0));
-    stream.extend((8..12).map(|x| px(0, x, 5)));
-    stream.extend([px(0, 13, 5), px(0, 12, 5), px(0, 14, 5)]);
-    stream.extend([px(0, 3, 2), px(0, 20, 6), px(0, 15, 5), px(0, 16, 5)]);
-
-    // Per pixel: the pixel each completion or error came after.
-    let mut single = sobel_ring::SobelRing::<20>::new();
-    single.start(20, 12, 2);
-    let mut expected = Vec::new();
-    for (i, p) in stream.iter().enumerate() {
-        match single.push(p) {
-            Ok(Some(c)) => expected.push((i, Ok(c))),
-            Ok(None) => {}
-            Err(e) => expected.push((i, Err(e))),
-        }
-    }
-
-    // In runs, as the Sobel FIFO groups the stream, going on after an error as the per-pixel
-    // loop did.
-    let mut fifo: SobelFifo<64, 2> = SobelFifo::new();
-    for p in &stream {
-        fifo.push(*p).expect("the stream fits");
-    }
-    let mut runs = sobel_ring::SobelRing::<20>::new();
-    runs.start(20, 12, 2);
-    let mut got = Vec::new();
-    let mut next = 0;
-    let mut queued = 0;
-    fifo.drain(usize::MAX, &mut |mut run| {
-        queued += 1;
-        while !run.is_empty() {
-            match runs.push_run(&run) {
-                Ok((taken, completed)) => {
-                    assert!(taken >= 1);
-                    next += taken;
-                    run = run.split_at(taken).1;
-                    if let Some(c) = completed {
-                        got.push((next - 1, Ok(c)));
-                    }
-                }
-                Err(e) => {
-                    got.push((next, Err(e)));
-                    next += 1;
-                    run = run.split_at(1).1;
-                }
-            }
-        }
-    });
-    assert!(queued < stream.len(), "some pixels form runs");
-    assert_eq!(got, expected);
-    assert!(expected.iter().any(|(_, r)| r.is_err()));
-    for octave in 0..2 {
-        for row in 0..12 {
-            assert_eq!(
-                single.row(octave, row),
-                runs.row(octave, row),
-                "{octave} {row}"
-            );
-        }
-        let (a, b) = (single.rows(octave).unwrap(), runs.rows(octave).unwrap());
-        assert_eq!(
-            (a.next_row(), a.oldest_row()),
-            (b.next_row(), b.oldest_row())
-        );
-    }
-}
-
-#[test]
-fn patch_queue_takes_the_first_ready_entry_and_keeps_the_others_in_order() {
-    let entry = |index: u16| patch::PendingPatch {
-        index,
-        octave: (index % 2) as u8,
-        x: index,
-        y: index,
-    };
-    let mut queue = patch::PatchQueue::new();
-    for index in 0..6 {
-        queue.push(entry(index)).unwrap();
-    }
-    assert_eq!(queue.take_first(|p| p.octave == 1), Some(entry(1)));
-    assert_eq!(queue.take_first(|p| p.index == 5), Some(entry(5)));
-    assert_eq!(queue.take_first(|p| p.index == 9), None);
-    let rest: Vec<u16> = core::iter::from_fn(|| queue.take_first(|_| true))
-        .map(|p| p.index)
-        .collect();
-    assert_eq!(rest, [0, 2, 3, 4]);
 }

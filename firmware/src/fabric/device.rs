@@ -55,17 +55,22 @@
 //! What a program can observe therefore matches the RTL register for register, but not clock
 //! for clock: the entries a line time brings arrive together at its end.
 
+use stereocal_hdl::regs::stream_fault::Cause;
 use stereocal_hdl::regs::{
     control, frame_count, latency_clocks, point_fifo_data, point_fifo_dsdog, point_fifo_dxdy,
     point_fifo_level, point_overflow_count, sobel_fifo_data, sobel_fifo_level, sobel_fifo_position,
-    sobel_overflow_count, status, version, WINDOW_SIZE,
+    sobel_overflow_count, status, stream_control, stream_fault, stream_patches_dropped,
+    stream_points, stream_sobel_packets, version, WINDOW_SIZE,
 };
 use stereocal_hdl::{PixelIn, RegisterBank, RegisterBus, Registers};
+use stereocal_wire::Camera;
 
 use crate::fabric::config::Config;
 use crate::fabric::fifo_words::{point_words, sobel_words, SOBEL_OFFSETS};
 use crate::fabric::latency;
 use crate::fabric::output::{FrontEnd, Overflow};
+use crate::fabric::stream::{StreamEngine, StreamFault, StreamFrame, Unwired};
+use crate::framing::ByteSink;
 
 /// Where the frame is (`sc_fabric`'s `state`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -97,10 +102,10 @@ struct Frame {
 }
 
 /// `sc_fabric` in software over the datapath `F`; `W0` is the longest line it gathers (the
-/// datapath's octave-0 line length).
-#[derive(Clone, Debug)]
-pub struct FabricDevice<F, const W0: usize = 1280> {
+/// datapath's octave-0 line length); its stream engine sends on the link `L`.
+pub struct FabricDevice<F, const W0: usize = 1280, L = Unwired> {
     datapath: F,
+    stream: StreamEngine<W0, L>,
     registers: RegisterBank,
     phase: Phase,
     frame: Frame,
@@ -119,12 +124,22 @@ pub struct FabricDevice<F, const W0: usize = 1280> {
     sobel_hold: u32,
 }
 
-impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
-    /// The device after power-up: registers at their reset values, no frame, empty FIFOs.
-    pub fn new(mut datapath: F) -> Self {
+impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0, Unwired> {
+    /// The device after power-up with nothing on its LINK_OUT port, for programs that read
+    /// the FIFOs through the registers.
+    pub fn new(datapath: F) -> Self {
+        Self::with_link(datapath, Unwired)
+    }
+}
+
+impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
+    /// The device after power-up, its stream engine on `link`: registers at their reset
+    /// values, no frame, empty FIFOs.
+    pub fn with_link(mut datapath: F, link: L) -> Self {
         datapath.reset();
         Self {
             datapath,
+            stream: StreamEngine::new(link),
             registers: RegisterBank::new(),
             phase: Phase::Idle,
             frame: Frame {
@@ -146,6 +161,16 @@ impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
         }
     }
 
+    /// The link the stream engine sends on.
+    pub fn link(&self) -> &L {
+        self.stream.link()
+    }
+
+    /// The link, mutably (to take what the stream engine sent).
+    pub fn link_mut(&mut self) -> &mut L {
+        self.stream.link_mut()
+    }
+
     /// Whether PIXEL_IN takes a pixel now.
     fn ready(&mut self) -> bool {
         matches!(self.phase, Phase::AwaitSof | Phase::Run) && self.registers.control_enable()
@@ -165,8 +190,26 @@ impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
             sobel_scale: r.output_mode_sobel_scale(),
             max_offset: r.max_offset_value(),
         };
+        let drops = self.datapath.overflow();
         if self.datapath.start_frame(&config).is_err() {
             return;
+        }
+        let r = &mut self.registers;
+        if r.stream_control_enable() {
+            let frame = StreamFrame {
+                frame_id: r.frame_id_value(),
+                camera: Camera::from(r.stream_control_camera()),
+                timestamp_us: u64::from(r.timestamp_hi_value()) << 32
+                    | u64::from(r.timestamp_lo_value()),
+                width: config.width,
+                height: config.height,
+                octaves: config.octaves,
+                mode: r.output_mode_sobel_output(),
+                sobel_scale: config.sobel_scale,
+                points_per_batch: r.output_mode_points_per_batch(),
+                row_segment: r.output_mode_row_segment(),
+            };
+            self.stream.start(frame, drops);
         }
         self.phase = Phase::AwaitSof;
         self.line_len = 0;
@@ -187,6 +230,7 @@ impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
     /// SOFT_RESET.
     fn soft_reset(&mut self) {
         self.datapath.reset();
+        self.stream.abort();
         self.phase = Phase::Idle;
         self.line_len = 0;
         self.flags = 0;
@@ -216,6 +260,7 @@ impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
         }
         self.drops_seen = drops;
         if self.phase == Phase::Flush && self.datapath.frame_done() {
+            self.stream.finish(self.datapath.overflow());
             self.phase = Phase::Idle;
             self.flags |= status::FRAME_DONE.mask();
             self.frame_count = self.frame_count.wrapping_add(1);
@@ -257,6 +302,7 @@ impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0> {
             // The row is `width` long and the frame has room for it (`push` counts), so the
             // datapath takes it.
             let _ = self.datapath.push_row(row);
+            self.stream.take(&mut self.datapath);
             self.advance(u32::from(self.frame.width));
         }
     }
@@ -292,7 +338,28 @@ fn level(entries: usize) -> u32 {
     u32::try_from(entries).map_or(u32::from(u16::MAX), |n| n.min(u16::MAX.into()))
 }
 
-impl<F: FrontEnd, const W0: usize> RegisterBus for FabricDevice<F, W0> {
+/// STREAM_FAULT's word for `fault`.
+fn fault_word(fault: Option<StreamFault>) -> u32 {
+    let (cause, octave, x, y) = match fault {
+        None => return 0,
+        Some(StreamFault::SobelOrder(p)) => (Cause::SobelOrder, p.octave, p.x, p.y),
+        Some(StreamFault::PointOutside { octave, x, y }) => (Cause::PointOutside, octave, x, y),
+        Some(StreamFault::Encode) => (Cause::Encode, 0, 0, 0),
+    };
+    // X and Y keep their low 11 bits, as the register's fields do.
+    let put = |field: &stereocal_hdl::Field, value: u32| {
+        field
+            .bits
+            .insert(0, value & field.bits.max_value())
+            .unwrap_or(0)
+    };
+    put(&stream_fault::CAUSE, cause as u32)
+        | put(&stream_fault::OCTAVE, u32::from(octave))
+        | put(&stream_fault::X, u32::from(x))
+        | put(&stream_fault::Y, u32::from(y))
+}
+
+impl<F: FrontEnd, const W0: usize, L: ByteSink> RegisterBus for FabricDevice<F, W0, L> {
     fn read(&mut self, offset: u16) -> u32 {
         let Some(offset) = word(offset) else {
             return 0;
@@ -314,6 +381,10 @@ impl<F: FrontEnd, const W0: usize> RegisterBus for FabricDevice<F, W0> {
             point_fifo_dsdog::OFFSET => self.point_hold[1],
             sobel_fifo_data::OFFSET => self.pop_sobel(),
             sobel_fifo_position::OFFSET => self.sobel_hold,
+            stream_points::OFFSET => self.stream.counts().points,
+            stream_sobel_packets::OFFSET => self.stream.counts().sobel_packets,
+            stream_patches_dropped::OFFSET => self.stream.counts().patches_dropped,
+            stream_fault::OFFSET => fault_word(self.stream.fault()),
             // CONTROL and the configuration: stored; other words read 0.
             _ => self.registers.try_read(offset).unwrap_or(0),
         }
@@ -363,6 +434,10 @@ impl<F: FrontEnd, const W0: usize> RegisterBus for FabricDevice<F, W0> {
                 }
             }
             status::OFFSET => self.flags &= !(value & status::REGISTER.w1c_mask),
+            stream_control::OFFSET => {
+                let _ = self.registers.try_write(offset, value);
+                self.stream.set_fec(stream_control::FEC.extract(value) != 0);
+            }
             // The configuration; the bank ignores writes to `ro` bits and unmapped words.
             _ => {
                 let _ = self.registers.try_write(offset, value);
@@ -371,7 +446,7 @@ impl<F: FrontEnd, const W0: usize> RegisterBus for FabricDevice<F, W0> {
     }
 }
 
-impl<F: FrontEnd, const W0: usize> PixelIn for FabricDevice<F, W0> {
+impl<F: FrontEnd, const W0: usize, L: ByteSink> PixelIn for FabricDevice<F, W0, L> {
     fn push(&mut self, pixels: &[u8], start_of_frame: bool) {
         if !self.ready() {
             return;
@@ -407,6 +482,7 @@ impl<F: FrontEnd, const W0: usize> PixelIn for FabricDevice<F, W0> {
                 while self.phase == Phase::Flush && self.frame.blank >= width && width > 0 {
                     self.frame.blank -= width;
                     self.datapath.blank_row();
+                    self.stream.take(&mut self.datapath);
                     self.advance(width);
                 }
             }

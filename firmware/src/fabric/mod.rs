@@ -1,7 +1,8 @@
 //! The FPGA front end ("fabric"), modelled stage by stage.
 //!
 //! [`FabricDevice`] is the fabric as a program sees it, `sc_fabric` behind its register map
-//! and PIXEL_IN port ([`device`]). Its datapath is one of two implementations producing
+//! and PIXEL_IN port ([`device`]), with its [`stream`] engine sending the frame's packets on
+//! the LINK_OUT port. Its datapath is one of two implementations producing
 //! bit-identical outputs behind one trait, [`FrontEnd`] ([`FabricModel`] picks one at run
 //! time):
 //! - [`RegisterFrontEnd`]: the register-level model, one [`RegisterFrontEnd::clock`] per pixel
@@ -47,6 +48,7 @@ pub mod probe;
 pub mod refine;
 pub mod sobel;
 pub mod sobel_fifo;
+pub mod stream;
 pub mod subsample;
 pub mod taps;
 pub mod window;

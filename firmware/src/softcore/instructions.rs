@@ -35,12 +35,15 @@ pub struct InstructionReport {
     pub camera: u8,
     /// Pixels of the image.
     pub pixels: u32,
-    /// Instructions inside the fabric model (the work the fabric does in hardware).
+    /// Instructions inside the fabric model (the work the fabric does in hardware: the
+    /// datapath, and the stream engine building, framing and writing the frame's packets),
+    /// its waits for the UART transmitter excluded.
     pub front_end: u64,
-    /// The rest of `process_frame`: reading the FIFOs, building and framing the packets,
-    /// writing the UART registers (the soft-core's own work).
+    /// The rest of `process_frame`: the driver's register accesses around the frame and the
+    /// loop that offers the image's rows (the soft-core's own work).
     pub driver: u64,
-    /// Instructions spent waiting for the UART transmitter.
+    /// Instructions spent waiting for the UART transmitter, by the soft-core and by the
+    /// stream engine's stand-in.
     pub uart_wait: u64,
 }
 
@@ -270,6 +273,11 @@ mod counted {
         /// Instructions counted since the last call.
         pub fn take(&self) -> u64 {
             self.instructions.take()
+        }
+
+        /// The wrapped fabric (calls through it are not counted).
+        pub fn inner_mut(&mut self) -> &mut D {
+            &mut self.inner
         }
 
         fn counted<R>(&mut self, f: impl FnOnce(&mut D) -> R) -> R {

@@ -10,7 +10,7 @@ use core::cell::RefCell;
 
 use critical_section::Mutex;
 
-use crate::driver::{ByteSink, PacketWriter};
+use crate::framing::{ByteSink, PacketWriter};
 use crate::softcore::instructions::instret;
 use crate::softcore::uart::{Ns16550, VIRT_UART0};
 

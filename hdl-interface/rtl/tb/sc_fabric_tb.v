@@ -318,7 +318,7 @@ module sc_fabric_tb;
         repeat (3) @(negedge clk);
         rst = 1'b0;
         read(8'h00, v);
-        check("VERSION", v, 32'h5C01_0200);
+        check("VERSION", v, 32'h5C01_0201);
         write(8'h0C, W);
         write(8'h10, H);
         write(8'h14, OCTAVES);

@@ -37,6 +37,12 @@ module sc_regs_tb;
     reg         svalid = 1'b0;
     wire        sobel_pop;
     reg  [15:0] sx = 16'h0, sy = 16'h0;
+    wire        stream_enable, stream_fec;
+    wire [7:0]  stream_camera;
+    wire [31:0] frame_id, timestamp_lo, timestamp_hi;
+    reg  [31:0] stream_points = 32'h0, stream_sobel_packets = 32'h0, stream_patches_dropped = 32'h0;
+    reg  [1:0]  fault_cause = 2'h0, fault_octave = 2'h0;
+    reg  [10:0] fault_x = 11'h0, fault_y = 11'h0;
 
     sc_regs dut (
         .clk(clk), .rst(rst), .flags_clear(flags_clear),
@@ -70,7 +76,15 @@ module sc_regs_tb;
         .sobel_fifo_data_octave(soct), .sobel_fifo_data_valid(svalid),
         .sobel_fifo_data_pop(sobel_pop),
         .sobel_fifo_position_x(sx), .sobel_fifo_position_y(sy),
-        .max_offset_value(max_offset_value)
+        .max_offset_value(max_offset_value),
+        .stream_control_enable(stream_enable), .stream_control_fec(stream_fec),
+        .stream_control_camera(stream_camera),
+        .frame_id_value(frame_id), .timestamp_lo_value(timestamp_lo),
+        .timestamp_hi_value(timestamp_hi),
+        .stream_points_count(stream_points), .stream_sobel_packets_count(stream_sobel_packets),
+        .stream_patches_dropped_count(stream_patches_dropped),
+        .stream_fault_cause(fault_cause), .stream_fault_octave(fault_octave),
+        .stream_fault_x(fault_x), .stream_fault_y(fault_y)
     );
 
     always #5 clk = ~clk;
@@ -112,7 +126,7 @@ module sc_regs_tb;
         rst = 1'b0;
 
         // Resets and constants.
-        expect_read("VERSION", 8'h00, 32'h5C01_0200);
+        expect_read("VERSION", 8'h00, 32'h5C01_0201);
         expect_read("CONTROL reset", 8'h04, 32'h0);
         expect_read("STATUS reset", 8'h08, 32'h0);
         expect_read("WIDTH reset", 8'h0C, 32'd640);
@@ -141,10 +155,20 @@ module sc_regs_tb;
         check("contrast port", {16'h0, contrast_threshold_value}, 32'h0100);
         check("edge port", {27'h0, edge_threshold_r}, 32'h0C);
         check("max_offset written", {16'h0, max_offset_value}, 32'h1FFF);
+        expect_read("STREAM_CONTROL reset", 8'h54, 32'h0);
+        write(8'h54, 32'hFFFF_FFFF);
+        expect_read("STREAM_CONTROL reserved", 8'h54, 32'h0000_FF03);
+        check("stream ports", {22'h0, stream_camera, stream_fec, stream_enable}, 32'h3FF);
+        write(8'h58, 32'hDEAD_BEEF);
+        write(8'h5C, 32'h0123_4567);
+        write(8'h60, 32'h89AB_CDEF);
+        expect_read("FRAME_ID rw", 8'h58, 32'hDEAD_BEEF);
+        check("frame_id port", frame_id, 32'hDEAD_BEEF);
+        check("timestamp ports", timestamp_lo ^ timestamp_hi, 32'h8888_8888);
 
         // ro: bus writes ignored, the fabric's value read.
         write(8'h00, 32'h0);
-        expect_read("VERSION after write", 8'h00, 32'h5C01_0200);
+        expect_read("VERSION after write", 8'h00, 32'h5C01_0201);
         point_level = 16'd512; sobel_level = 16'd3840;
         point_overflows = 32'hFFFF_FFFF; sobel_overflows = 32'd7; frames = 32'd3;
         latency = 32'd1234; dx = 16'hF000; dy = 16'h0800; ds = 16'hFFFF; dog = 16'hFC80;
@@ -159,6 +183,12 @@ module sc_regs_tb;
         expect_read("POINT_FIFO_DXDY", 8'h40, 32'h0800_F000);
         expect_read("POINT_FIFO_DSDOG", 8'h44, 32'hFC80_FFFF);
         expect_read("SOBEL_FIFO_POSITION", 8'h4C, 32'h00EF_013F);
+        stream_points = 32'd1000; stream_sobel_packets = 32'd77; stream_patches_dropped = 32'd5;
+        fault_cause = 2'd1; fault_octave = 2'd3; fault_x = 11'd1279; fault_y = 11'd1023;
+        expect_read("STREAM_POINTS", 8'h64, 32'd1000);
+        expect_read("STREAM_SOBEL_PACKETS", 8'h68, 32'd77);
+        expect_read("STREAM_PATCHES_DROPPED", 8'h6C, 32'd5);
+        expect_read("STREAM_FAULT", 8'h70, {6'h0, 11'd1023, 11'd1279, 2'd3, 2'd1});
 
         // w1c: set by the fabric, cleared by writing 1, a set beats a clear on one clock.
         status_busy = 1'b1;
@@ -219,9 +249,9 @@ module sc_regs_tb;
         check("writes do not pop", point_pops, 2);
 
         // Unmapped offsets: read 0, writes change nothing.
-        expect_read("unmapped 0x54", 8'h54, 32'h0);
+        expect_read("unmapped 0x74", 8'h74, 32'h0);
         expect_read("unmapped 0xFC", 8'hFC, 32'h0);
-        write(8'h54, 32'hFFFF_FFFF);
+        write(8'h74, 32'hFFFF_FFFF);
         write(8'hFC, 32'hFFFF_FFFF);
         expect_read("WIDTH kept", 8'h0C, 32'h0500);
         expect_read("misaligned byte address reads its word", 8'h0E, 32'h0500);

@@ -3,14 +3,15 @@
 //!
 //! This is the default link of `stereocal run/eval/demo`: the same firmware code as the ELF,
 //! the same wire bytes as QEMU or a board, without a process or a socket in between. Images
-//! go in through [`InProcessLink::submit_pair`]; the driver's packets collect in an outbox
+//! go in through [`InProcessLink::submit_pair`]; the device's packets collect in an outbox
 //! that [`Link::recv`] hands out. The fabric runs its fast path unless
 //! [`InProcessLink::register_level`] asks for the clock-level model.
 //!
 //! The two cameras' channels run on two cores at once ([`InProcessLink::submit_pair`]) and
-//! their packets are queued left camera first, as the soft-core sends them. Each channel
-//! numbers its packets as its own wire source, so the bytes equal the soft-core's whichever
-//! channel finishes first, and nothing rewrites a channel's frames.
+//! their packets are queued left camera first, as the soft-core sends them. Each channel's
+//! fabric sends its frames on a link port of its own (its stream engine's outbox here),
+//! numbered as the camera's wire source, so the bytes equal the soft-core's whichever channel
+//! finishes first, and nothing rewrites a channel's frames.
 //!
 //! Register writes from the host go to both channels (the head's two fabrics are configured
 //! alike); `Hello` and register reads are answered by the left channel, so each request gets
@@ -18,10 +19,9 @@
 
 use std::time::Instant;
 
-use stereocal_firmware::driver::{
-    ByteSink, Driver as Channel, DriverError as ChannelError, FrameSummary, PacketWriter,
-};
+use stereocal_firmware::driver::{Driver as Channel, DriverError as ChannelError, FrameSummary};
 use stereocal_firmware::fabric::{FabricDevice, FabricModel};
+use stereocal_firmware::framing::{ByteSink, PacketWriter};
 use stereocal_hdl::regs::control;
 use stereocal_hdl::RegisterBus;
 use stereocal_wire::{Accumulator, Camera, EncodersRepr, FeedResult, PacketRepr, MAX_ENCODED_LEN};
@@ -32,8 +32,8 @@ use super::{Link, LinkError};
 const NAME: &str = "in-process";
 
 /// One camera's channel at the fabric's full size (1280-pixel lines): the firmware's driver on
-/// the registers of the fabric's device model.
-type FullChannel = Channel<FabricDevice<FabricModel>, 1280>;
+/// the registers of the fabric's device model, whose stream engine sends into an outbox.
+type FullChannel = Channel<FabricDevice<FabricModel, 1280, Outbox>, 1280>;
 
 /// The device's output, waiting for the host to read it.
 #[derive(Debug, Default)]
@@ -83,10 +83,6 @@ pub struct InProcessLink {
     left: Box<FullChannel>,
     right: Box<FullChannel>,
     writer: PacketWriter<Outbox>,
-    /// Each camera's packets of the pair being run, before they join `writer`'s outbox; kept
-    /// from pair to pair for their allocations. Only their sinks and frame buffers are used:
-    /// the channels number their own packets.
-    pair_out: [PacketWriter<Outbox>; 2],
     inbox: Box<Accumulator<{ MAX_ENCODED_LEN - 1 }>>,
 }
 
@@ -106,10 +102,6 @@ impl InProcessLink {
             left: boxed_channel(Camera::Left, model)?,
             right: boxed_channel(Camera::Right, model)?,
             writer: PacketWriter::new(Outbox::default()),
-            pair_out: [
-                PacketWriter::new(Outbox::default()),
-                PacketWriter::new(Outbox::default()),
-            ],
             inbox: Box::new(Accumulator::new()),
         })
     }
@@ -129,16 +121,19 @@ impl InProcessLink {
                 return Err(LinkError::Device(format!("no camera channel {c}")));
             }
         };
-        channel
-            .process_frame(image, timestamp_us, &mut self.writer)
-            .map_err(|e| channel_error(camera, &e))
+        let result = channel.process_frame(image, timestamp_us);
+        self.writer
+            .sink_mut()
+            .append(&mut channel.bus_mut().link_mut().bytes);
+        result.map_err(|e| channel_error(camera, &e))
     }
 
     /// Runs a stereo pair: the frame's packets of both cameras wait in the outbox, the left
     /// camera's first, the two frames carry the same frame id.
     ///
-    /// The channels run concurrently, each into an outbox of its own, numbering its packets
-    /// as its source; the two outboxes then join the link's as they are, left first: the
+    /// The channels run concurrently, each fabric's stream engine into an outbox of its own,
+    /// numbering its packets as its source; the two outboxes then join the link's as they are,
+    /// left first: the
     /// bytes are those of running the two one after the other, as the soft-core does.
     /// Run one after the other, a left frame refused before its `FrameStart` (a wrong image
     /// size; register errors refuse both alike) would leave the right camera unrun and both
@@ -163,17 +158,17 @@ impl InProcessLink {
             left: left_channel,
             right: right_channel,
             writer,
-            pair_out: [left_out, right_out],
             ..
         } = self;
-        left_out.sink_mut().clear();
-        right_out.sink_mut().clear();
         let (left_result, right_result) = rayon::join(
-            || left_channel.process_frame(left, timestamp_us, left_out),
-            || right_channel.process_frame(right, timestamp_us, right_out),
+            || left_channel.process_frame(left, timestamp_us),
+            || right_channel.process_frame(right, timestamp_us),
         );
-        writer.sink_mut().append(&mut left_out.sink_mut().bytes);
-        writer.sink_mut().append(&mut right_out.sink_mut().bytes);
+        for channel in [left_channel, right_channel] {
+            writer
+                .sink_mut()
+                .append(&mut channel.bus_mut().link_mut().bytes);
+        }
         let left_summary = left_result.map_err(|e| channel_error(Camera::Left, &e))?;
         let right_summary = right_result.map_err(|e| channel_error(Camera::Right, &e))?;
         Ok([left_summary, right_summary])
@@ -214,7 +209,10 @@ fn boxed_channel(
     let builder = std::thread::Builder::new()
         .name("in-process channel".into())
         .stack_size(BUILD_STACK);
-    let build = move || Box::new(Channel::new(FabricDevice::new(model()), camera));
+    let build = move || {
+        let fabric = FabricDevice::with_link(model(), Outbox::default());
+        Box::new(Channel::new(fabric, camera))
+    };
     builder
         .spawn(build)
         .map_err(|e| LinkError::Device(format!("cannot start the {camera:?} channel: {e}")))?
@@ -247,10 +245,16 @@ impl Link for InProcessLink {
                         .left
                         .handle_host_packet(&packet, &mut self.writer)
                         .map_err(|e| channel_error(Camera::Left, &e));
-                    // A `Hello` sets the link's error correction; the cameras' frames take
-                    // the same link.
-                    let fec = self.writer.fec();
-                    self.pair_out.iter_mut().for_each(|w| w.set_fec(fec));
+                    // A `Hello` sets the link's error correction; the right camera's frames
+                    // take the same link.
+                    let answered = match packet {
+                        PacketRepr::Hello(_) => answered.and_then(|()| {
+                            self.right
+                                .set_fec(self.writer.fec())
+                                .map_err(|e| channel_error(Camera::Right, &e))
+                        }),
+                        _ => answered,
+                    };
                     (answered, remaining)
                 }
             };

@@ -330,3 +330,99 @@ impl<const W0: usize> Default for SobelRing<W0> {
         Self::new()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use std::vec::Vec;
+
+    use super::*;
+    use crate::fabric::sobel_fifo::SobelFifo;
+
+    #[test]
+    fn push_run_reports_what_pixel_by_pixel_pushes_report() {
+        let px = |octave: u8, x: u16, y: u16| SobelEntry {
+            octave,
+            orientation: (x % 64) as u8,
+            magnitude: (y % 251) as u8 + 1,
+            x,
+            y,
+        };
+        // Octave 0 is 20 wide, octave 1 is 10 wide: whole rows, rows with gaps, octaves
+        // interleaved mid-row, a skipped row, an octave the frame lacks, columns going back, a row
+        // gone by and a column past the edge.
+        let mut stream: Vec<SobelEntry> = (0..20).map(|x| px(0, x, 0)).collect();
+        stream.extend((0..6).map(|x| px(1, x, 0)));
+        stream.extend((0..20).filter(|&x| x != 9).map(|x| px(0, x, 1)));
+        stream.extend((6..10).map(|x| px(1, x, 0)));
+        stream.extend((3..19).map(|x| px(0, x, 2)));
+        stream.extend((0..20).map(|x| px(0, x, 4)));
+        stream.extend((5..8).map(|x| px(0, x, 5)));
+        stream.push(px(2, 0, 0));
+        stream.extend((8..12).map(|x| px(0, x, 5)));
+        stream.extend([px(0, 13, 5), px(0, 12, 5), px(0, 14, 5)]);
+        stream.extend([px(0, 3, 2), px(0, 20, 6), px(0, 15, 5), px(0, 16, 5)]);
+
+        // Per pixel: the pixel each completion or error came after.
+        let mut single = SobelRing::<20>::new();
+        single.start(20, 12, 2);
+        let mut expected = Vec::new();
+        for (i, p) in stream.iter().enumerate() {
+            match single.push(p) {
+                Ok(Some(c)) => expected.push((i, Ok(c))),
+                Ok(None) => {}
+                Err(e) => expected.push((i, Err(e))),
+            }
+        }
+
+        // In runs, as the Sobel FIFO groups the stream, going on after an error as the per-pixel
+        // loop did.
+        let mut fifo: SobelFifo<64, 2> = SobelFifo::new();
+        for p in &stream {
+            fifo.push(*p).expect("the stream fits");
+        }
+        let mut runs = SobelRing::<20>::new();
+        runs.start(20, 12, 2);
+        let mut got = Vec::new();
+        let mut next = 0;
+        let mut queued = 0;
+        fifo.drain(usize::MAX, &mut |mut run| {
+            queued += 1;
+            while !run.is_empty() {
+                match runs.push_run(&run) {
+                    Ok((taken, completed)) => {
+                        assert!(taken >= 1);
+                        next += taken;
+                        run = run.split_at(taken).1;
+                        if let Some(c) = completed {
+                            got.push((next - 1, Ok(c)));
+                        }
+                    }
+                    Err(e) => {
+                        got.push((next, Err(e)));
+                        next += 1;
+                        run = run.split_at(1).1;
+                    }
+                }
+            }
+        });
+        assert!(queued < stream.len(), "some pixels form runs");
+        assert_eq!(got, expected);
+        assert!(expected.iter().any(|(_, r)| r.is_err()));
+        for octave in 0..2 {
+            for row in 0..12 {
+                assert_eq!(
+                    single.row(octave, row),
+                    runs.row(octave, row),
+                    "{octave} {row}"
+                );
+            }
+            let (a, b) = (single.rows(octave).unwrap(), runs.rows(octave).unwrap());
+            assert_eq!(
+                (a.next_row(), a.oldest_row()),
+                (b.next_row(), b.oldest_row())
+            );
+        }
+    }
+}

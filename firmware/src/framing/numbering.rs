@@ -1,9 +1,9 @@
 //! One source's sequence numbers.
 //!
-//! Each sender on the link (the soft-core's control packets, each camera channel) is a wire
-//! source with a numbering of its own, kept by the sender: a channel numbers its frames'
-//! packets without knowing how many another channel sent, so channels can run on separate
-//! cores and their frames be queued in any order without touching their bytes.
+//! Each sender on the link (the soft-core's control packets, each camera channel's stream
+//! engine) is a wire source with a numbering of its own, kept by the sender: a channel numbers
+//! its frames' packets without knowing how many another channel sent, so channels can run on
+//! separate cores and their frames be queued in any order without touching their bytes.
 
 use stereocal_wire::Source;
 

@@ -2,7 +2,7 @@
 //!
 //! A point at row `y` of its octave needs Sobel rows `y-8..=y+7` (clipped to the image). The
 //! fabric's point stream lags its Sobel stream by a few rows, so a point usually arrives with
-//! its top rows already in the [`SobelRing`](crate::driver::sobel_ring::SobelRing) and waits
+//! its top rows already in the [`SobelRing`](crate::fabric::stream::sobel_ring::SobelRing) and waits
 //! for the rows below it. A point whose top rows have already left the ring, or that finds
 //! the queue full, gets no patch; the driver counts it in `FrameEnd.dropped_sobel`.
 
@@ -87,5 +87,35 @@ impl PatchQueue {
 impl Default for PatchQueue {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use std::vec::Vec;
+
+    use super::*;
+
+    #[test]
+    fn patch_queue_takes_the_first_ready_entry_and_keeps_the_others_in_order() {
+        let entry = |index: u16| PendingPatch {
+            index,
+            octave: (index % 2) as u8,
+            x: index,
+            y: index,
+        };
+        let mut queue = PatchQueue::new();
+        for index in 0..6 {
+            queue.push(entry(index)).unwrap();
+        }
+        assert_eq!(queue.take_first(|p| p.octave == 1), Some(entry(1)));
+        assert_eq!(queue.take_first(|p| p.index == 5), Some(entry(5)));
+        assert_eq!(queue.take_first(|p| p.index == 9), None);
+        let rest: Vec<u16> = core::iter::from_fn(|| queue.take_first(|_| true))
+            .map(|p| p.index)
+            .collect();
+        assert_eq!(rest, [0, 2, 3, 4]);
     }
 }
