@@ -19,7 +19,9 @@
 //! byte after that first link frame must be identical: register answers, every frame's
 //! packets, their sequence numbers and CRCs.
 
+pub mod fabric_contract;
 pub mod rtl;
+pub mod rtl_fabric;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
