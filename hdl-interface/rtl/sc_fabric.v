@@ -11,13 +11,15 @@
 //   act (at that clock's edge). What a read on that clock shows is made to agree with what the
 //   write asked for, so a driver may read on the very next clock: STATUS.BUSY is 1 from the
 //   clock after an accepted FRAME_ARM (BUSY = the frame state or the arm acting now), and
-//   everything SOFT_RESET clears reads cleared from the clock after its write (below).
+//   everything SOFT_RESET clears reads cleared from the clock after its write (all but the
+//   sticky flags, below). The device model's clock-exact entry point (FabricDevice::clock)
+//   is this contract, compared read for read by tests/tests/rtl_fabric_contract.rs.
 // - FRAME_ARM (ignored while BUSY) starts sc_frontend (its `start`: the configuration
 //   registers WIDTH, HEIGHT, OCTAVES, CONTRAST_THRESHOLD, EDGE_THRESHOLD.R,
 //   OUTPUT_MODE.SOBEL_SCALE and MAX_OFFSET are latched) and raises BUSY. The driver validates
 //   the configuration before writing it (FabricConfig::validate; the model's Config::validate
 //   on width <= W0 and the last octave >= 3 x 3): the RTL does not check it again.
-// - From the next clock PIXEL_IN is ready while CONTROL.ENABLE is 1. Pixels before the first
+// - From the clock after the strobe's PIXEL_IN is ready while CONTROL.ENABLE is 1. Pixels before the first
 //   one with SOF are taken and discarded; the SOF pixel is pixel (0, 0), and the frame is the
 //   next WIDTH x HEIGHT pixels taken (SOF/EOL inside the frame are not checked). Each taken
 //   pixel is one `clock(Some(p))` of the model; every other clock is `clock(None)`.
