@@ -1,7 +1,9 @@
-//! Builds the RTL co-simulation model (see `src/rtl.rs`): `verilator --cc` on
-//! `hdl-interface/rtl/*.v` (top `sc_frontend`) into `OUT_DIR`, then the generated C++, the
-//! Verilator runtime and the shim `hdl-interface/sim/sc_sim.cpp` compiled and linked with the
-//! `cc` crate. On success it sets `cfg(rtl_sim)`.
+//! Builds the RTL co-simulation models: `verilator --cc` on `hdl-interface/rtl/*.v` twice
+//! into `OUT_DIR`, top `sc_frontend` (wrapped by the shim `hdl-interface/sim/sc_sim.cpp`,
+//! used by `src/rtl.rs`) and top `sc_fabric` with the small sizes of [`FABRIC_PARAMS`]
+//! (wrapped by `hdl-interface/sim/sc_fabric_sim.cpp`, used by `src/rtl_fabric.rs`), then the
+//! generated C++, the Verilator runtime and the shims compiled and linked with the `cc`
+//! crate. On success it sets `cfg(rtl_sim)`.
 //!
 //! Without `verilator` on `PATH` (or before `sc_frontend.v` exists) the model is not built and
 //! `STEREOCAL_RTL_SKIP` carries the reason, which the rtl tests print loudly before passing;
@@ -12,6 +14,39 @@ use std::env;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// `sc_fabric`'s parameters in the contract co-simulation: line memories of 64 pixels and
+/// FIFOs of 8 points and 3 x 64 Sobel pixels, so that small frames fill both FIFOs and the
+/// model stays small to compile. `src/rtl_fabric.rs` builds the device model with the same
+/// sizes and checks them against the shim's `sc_fabric_sim_params`.
+const FABRIC_PARAMS: [(&str, u32); 6] = [
+    ("W0", 64),
+    ("W1", 32),
+    ("W2", 16),
+    ("W3", 12),
+    ("POINT_DEPTH", 8),
+    ("SOBEL_DEPTH", 192),
+];
+
+/// One Verilated top and the shim around it.
+struct Top {
+    module: &'static str,
+    params: &'static [(&'static str, u32)],
+    shim: &'static str,
+}
+
+const TOPS: [Top; 2] = [
+    Top {
+        module: "sc_frontend",
+        params: &[],
+        shim: "sc_sim.cpp",
+    },
+    Top {
+        module: "sc_fabric",
+        params: &FABRIC_PARAMS,
+        shim: "sc_fabric_sim.cpp",
+    },
+];
 
 fn main() {
     println!("cargo::rustc-check-cfg=cfg(rtl_sim)");
@@ -66,32 +101,55 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
     }
 
     let out = PathBuf::from(env::var("OUT_DIR").expect("OUT_DIR"));
-    let mdir = out.join("vobj");
-    if mdir.exists() {
-        fs::remove_dir_all(&mdir).expect("clean the Verilator output directory");
+    let vobj = out.join("vobj");
+    if vobj.exists() {
+        fs::remove_dir_all(&vobj).expect("clean the Verilator output directory");
     }
-    let status = Command::new("verilator")
-        .args([
-            "--cc",
-            "-O3",
-            "--x-assign",
-            "fast",
-            "--x-initial",
-            "unique",
-            "--noassert",
-        ])
-        .args(["-Wno-fatal", "-Wno-lint", "-Wno-style"])
-        .args(["--top-module", "sc_frontend", "--prefix", "Vsc_frontend"])
-        .arg("--Mdir")
-        .arg(&mdir)
-        .args(&sources)
-        .status()
-        .map_err(|e| format!("running verilator: {e}"))?;
-    assert!(
-        status.success(),
-        "verilator --cc failed on {} (see its messages above)",
-        rtl.display()
-    );
+    fs::create_dir_all(&vobj).expect("create the Verilator output directory");
+    // Both tops at once (Verilator runs on one core).
+    let runs: Vec<_> = TOPS
+        .iter()
+        .map(|top| {
+            let mdir = vobj.join(top.module);
+            let child = Command::new("verilator")
+                .args([
+                    "--cc",
+                    "-O3",
+                    "--x-assign",
+                    "fast",
+                    "--x-initial",
+                    "unique",
+                    "--noassert",
+                ])
+                .args(["-Wno-fatal", "-Wno-lint", "-Wno-style"])
+                .args(["--top-module", top.module, "--prefix"])
+                .arg(format!("V{}", top.module))
+                .args(
+                    top.params
+                        .iter()
+                        .map(|(name, value)| format!("-G{name}={value}")),
+                )
+                .arg("--Mdir")
+                .arg(&mdir)
+                .args(&sources)
+                .spawn()
+                .map_err(|e| format!("running verilator: {e}"))?;
+            Ok((top, mdir, child))
+        })
+        .collect::<Result<_, String>>()?;
+    let mut mdirs = Vec::new();
+    for (top, mdir, mut child) in runs {
+        let status = child
+            .wait()
+            .map_err(|e| format!("running verilator: {e}"))?;
+        assert!(
+            status.success(),
+            "verilator --cc (top {}) failed on {} (see its messages above)",
+            top.module,
+            rtl.display()
+        );
+        mdirs.push((top, mdir));
+    }
 
     let root = Command::new("verilator")
         .args(["--getenv", "VERILATOR_ROOT"])
@@ -103,13 +161,6 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
         return Err(format!("no verilated.cpp under {}", include.display()));
     }
 
-    let mut generated: Vec<PathBuf> = fs::read_dir(&mdir)
-        .expect("Verilator output directory")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "cpp"))
-        .collect();
-    generated.sort();
-
     // Every translation unit on its own, NUM_JOBS at a time: the model's code at -O2, the
     // run-once construction code (`*__Slow.cpp`) at -O0, the Verilator runtime at -O1.
     let mut base = cc::Build::new();
@@ -118,7 +169,6 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
         .warnings(false)
         .debug(false)
         .cargo_metadata(false)
-        .include(&mdir)
         .include(&include)
         .include(include.join("vltstd"))
         .include(sim)
@@ -128,18 +178,33 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
         .define("VM_TRACE_FST", "0")
         .define("VM_TRACE_VCD", "0")
         .flag("-faligned-new");
-    let mut units: Vec<(PathBuf, u32)> = generated
-        .into_iter()
-        .map(|p| {
+    // Each unit with its optimization level and the build that compiles it (a top's own
+    // include directory and, for a shim, the top's parameters as SC_<MODULE>_<NAME> macros).
+    let mut units: Vec<(PathBuf, u32, cc::Build)> = vec![
+        (include.join("verilated.cpp"), 1, base.clone()),
+        (include.join("verilated_threads.cpp"), 1, base.clone()),
+    ];
+    for (top, mdir) in &mdirs {
+        let mut build = base.clone();
+        build.include(mdir);
+        let mut generated: Vec<PathBuf> = fs::read_dir(mdir)
+            .expect("Verilator output directory")
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "cpp"))
+            .collect();
+        generated.sort();
+        for p in generated {
             let slow = p.to_string_lossy().ends_with("__Slow.cpp");
-            (p, if slow { 0 } else { 2 })
-        })
-        .collect();
-    units.push((include.join("verilated.cpp"), 1));
-    units.push((include.join("verilated_threads.cpp"), 1));
-    units.push((sim.join("sc_sim.cpp"), 2));
+            units.push((p, if slow { 0 } else { 2 }, build.clone()));
+        }
+        let prefix = top.module.to_uppercase();
+        for (name, value) in top.params {
+            build.define(&format!("{prefix}_{name}"), value.to_string().as_str());
+        }
+        units.push((sim.join(top.shim), 2, build));
+    }
     // Largest first, so the long ones do not end up last on one core.
-    units.sort_by_key(|(p, _)| std::cmp::Reverse(fs::metadata(p).map_or(0, |m| m.len())));
+    units.sort_by_key(|(p, ..)| std::cmp::Reverse(fs::metadata(p).map_or(0, |m| m.len())));
     let jobs = env::var("NUM_JOBS")
         .ok()
         .and_then(|j| j.parse::<usize>().ok())
@@ -153,9 +218,12 @@ fn build(rtl: &Path, sim: &Path) -> Result<(), String> {
                     let mut objs = Vec::new();
                     loop {
                         let next = queue.lock().expect("queue").next();
-                        let Some((file, opt)) = next else { break objs };
+                        let Some((file, opt, build)) = next else {
+                            break objs;
+                        };
                         objs.extend(
-                            base.clone()
+                            build
+                                .clone()
                                 .opt_level(opt)
                                 .file(&file)
                                 .compile_intermediates(),

@@ -7,12 +7,19 @@
 // bus_rdata); a standard AXI4-lite front end drives it and `rst` (from !ARESETN).
 //
 // Frame control (CONTROL, STATUS):
+// - CONTROL's strobes are sc_regs' `wo` outputs: high on the clock after the write, when they
+//   act (at that clock's edge). What a read on that clock shows is made to agree with what the
+//   write asked for, so a driver may read on the very next clock: STATUS.BUSY is 1 from the
+//   clock after an accepted FRAME_ARM (BUSY = the frame state or the arm acting now), and
+//   everything SOFT_RESET clears reads cleared from the clock after its write (all but the
+//   sticky flags, below). The device model's clock-exact entry point (FabricDevice::clock)
+//   is this contract, compared read for read by tests/tests/rtl_fabric_contract.rs.
 // - FRAME_ARM (ignored while BUSY) starts sc_frontend (its `start`: the configuration
 //   registers WIDTH, HEIGHT, OCTAVES, CONTRAST_THRESHOLD, EDGE_THRESHOLD.R,
 //   OUTPUT_MODE.SOBEL_SCALE and MAX_OFFSET are latched) and raises BUSY. The driver validates
 //   the configuration before writing it (FabricConfig::validate; the model's Config::validate
 //   on width <= W0 and the last octave >= 3 x 3): the RTL does not check it again.
-// - From the next clock PIXEL_IN is ready while CONTROL.ENABLE is 1. Pixels before the first
+// - From the clock after the strobe's PIXEL_IN is ready while CONTROL.ENABLE is 1. Pixels before the first
 //   one with SOF are taken and discarded; the SOF pixel is pixel (0, 0), and the frame is the
 //   next WIDTH x HEIGHT pixels taken (SOF/EOL inside the frame are not checked). Each taken
 //   pixel is one `clock(Some(p))` of the model; every other clock is `clock(None)`.
@@ -21,7 +28,10 @@
 //   FRAME_COUNT counts the frame.
 // - SOFT_RESET empties both FIFOs, returns to idle, restarts sc_frontend (clearing its valid
 //   bits), clears the STATUS flags, the overflow counters, FRAME_COUNT, LATENCY_CLOCKS and the
-//   holding registers. Configuration registers keep their values.
+//   holding registers. Configuration registers keep their values. On the strobe's clock the
+//   levels, counters, LATENCY_CLOCKS, FIFO heads (VALID 0; the pop is ignored), holding
+//   registers and BUSY already read their cleared values; only STATUS's sticky flags, which
+//   sc_regs holds, still read their old values on that one clock.
 //
 // FIFO entries, and arbitration between octaves: the four octaves may each push a point and a
 // Sobel pixel on the same clock. Both FIFOs take up to 4 entries per clock in octave order
@@ -85,6 +95,7 @@ module sc_fabric #(
     wire        point_fifo_data_pop, sobel_fifo_data_pop;
 
     wire        busy;
+    wire        busy_shown;           // STATUS.BUSY
     wire        frame_end;            // BUSY falls on this clock
     wire        soft_reset = control_soft_reset;
     reg  [31:0] frame_count;
@@ -113,9 +124,13 @@ module sc_fabric #(
     wire [87:0] pf_head;
     wire [47:0] sf_head;
     wire        pf_nonempty, sf_nonempty;
+    // What the registers show: on SOFT_RESET's clock, the values it clears (shown = 0).
+    wire        shown = !soft_reset;
     // What word 0 shows: the head, or all zero when the FIFO is empty.
-    wire [87:0] pf_shown = pf_nonempty ? pf_head : 88'd0;
-    wire [47:0] sf_shown = sf_nonempty ? sf_head : 48'd0;
+    wire        pf_valid = pf_nonempty && shown;
+    wire        sf_valid = sf_nonempty && shown;
+    wire [87:0] pf_shown = pf_valid ? pf_head : 88'd0;
+    wire [47:0] sf_shown = sf_valid ? sf_head : 48'd0;
     wire [15:0] pf_level16, sf_level16;
     wire [31:0] pf_dropped32, sf_dropped32;
     wire        pf_dropping, sf_dropping;
@@ -126,7 +141,7 @@ module sc_fabric #(
         .bus_rdata(bus_rdata),
         .control_enable(control_enable), .control_frame_arm(control_frame_arm),
         .control_soft_reset(control_soft_reset),
-        .status_busy(busy),
+        .status_busy(busy_shown),
         .status_frame_done(status_frame_done), .status_frame_done_set(frame_end),
         .status_point_overflow(status_point_overflow),
         .status_point_overflow_set(pf_dropping),
@@ -140,21 +155,25 @@ module sc_fabric #(
         .output_mode_sobel_scale(output_mode_sobel_scale),
         .output_mode_points_per_batch(output_mode_points_per_batch),
         .output_mode_row_segment(output_mode_row_segment),
-        .point_fifo_level_level(pf_level16), .sobel_fifo_level_level(sf_level16),
-        .point_overflow_count_count(pf_dropped32),
-        .sobel_overflow_count_count(sf_dropped32),
-        .frame_count_count(frame_count), .latency_clocks_clocks(latency),
+        .point_fifo_level_level(pf_level16 & {16{shown}}),
+        .sobel_fifo_level_level(sf_level16 & {16{shown}}),
+        .point_overflow_count_count(pf_dropped32 & {32{shown}}),
+        .sobel_overflow_count_count(sf_dropped32 & {32{shown}}),
+        .frame_count_count(frame_count & {32{shown}}),
+        .latency_clocks_clocks(latency & {32{shown}}),
         .point_fifo_data_x(pf_shown[10:0]), .point_fifo_data_y(pf_shown[21:11]),
-        .point_fifo_data_octave(pf_shown[87:86]), .point_fifo_data_scale({1'b0, pf_nonempty}),
-        .point_fifo_data_valid(pf_nonempty), .point_fifo_data_pop(point_fifo_data_pop),
-        .point_fifo_dxdy_dx(hold_dxdy[15:0]), .point_fifo_dxdy_dy(hold_dxdy[31:16]),
-        .point_fifo_dsdog_ds(hold_dsdog[15:0]), .point_fifo_dsdog_dog(hold_dsdog[31:16]),
+        .point_fifo_data_octave(pf_shown[87:86]), .point_fifo_data_scale({1'b0, pf_valid}),
+        .point_fifo_data_valid(pf_valid), .point_fifo_data_pop(point_fifo_data_pop),
+        .point_fifo_dxdy_dx(hold_dxdy[15:0] & {16{shown}}),
+        .point_fifo_dxdy_dy(hold_dxdy[31:16] & {16{shown}}),
+        .point_fifo_dsdog_ds(hold_dsdog[15:0] & {16{shown}}),
+        .point_fifo_dsdog_dog(hold_dsdog[31:16] & {16{shown}}),
         .sobel_fifo_data_magnitude(sf_shown[39:32]),
         .sobel_fifo_data_orientation(sf_shown[45:40]),
         .sobel_fifo_data_octave(sf_shown[47:46]),
-        .sobel_fifo_data_valid(sf_nonempty), .sobel_fifo_data_pop(sobel_fifo_data_pop),
-        .sobel_fifo_position_x(hold_position[15:0]),
-        .sobel_fifo_position_y(hold_position[31:16]),
+        .sobel_fifo_data_valid(sf_valid), .sobel_fifo_data_pop(sobel_fifo_data_pop),
+        .sobel_fifo_position_x(hold_position[15:0] & {16{shown}}),
+        .sobel_fifo_position_y(hold_position[31:16] & {16{shown}}),
         .max_offset_value(max_offset_value),
         .stream_control_enable(stream_control_enable), .stream_control_fec(stream_control_fec),
         .stream_control_camera(stream_control_camera),
@@ -185,6 +204,9 @@ module sc_fabric #(
 
     assign busy = state != S_IDLE;
     wire arm = control_frame_arm && !busy && !soft_reset && !rst;
+    // BUSY from the clock after an accepted FRAME_ARM: a driver that reads STATUS on the next
+    // clock sees the arm taken (arm is 0 on SOFT_RESET's clock, and so is busy_shown).
+    assign busy_shown = (busy || arm) && shown;
     assign pixel_in_ready = control_enable && !soft_reset
                          && (state == S_SOF || state == S_RUN);
     wire take = pixel_in_valid && pixel_in_ready;

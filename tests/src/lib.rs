@@ -18,8 +18,15 @@
 //! `LOG` capability added (it has a defmt logger; the in-process device does not). Every
 //! byte after that first link frame must be identical: register answers, every frame's
 //! packets, their sequence numbers and CRCs.
+//!
+//! The RTL co-simulations (Verilated by `build.rs`; without Verilator they skip loudly):
+//! [`rtl`] clocks `sc_frontend` beside the register-level model and compares every
+//! observation port; [`fabric_contract`] clocks the whole `sc_fabric` ([`rtl_fabric`]) beside
+//! the device model's clock-exact entry point and compares every word read over the bus.
 
+pub mod fabric_contract;
 pub mod rtl;
+pub mod rtl_fabric;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

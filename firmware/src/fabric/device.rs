@@ -1,11 +1,14 @@
 //! The fabric as a device: `sc_fabric` (`hdl-interface/rtl/sc_fabric.v`) in software, behind
-//! the register map ([`RegisterBus`]) and the PIXEL_IN port ([`PixelIn`]).
+//! the register map ([`RegisterBus`]) and the PIXEL_IN port ([`PixelIn`]), with its stream
+//! engine ([`crate::fabric::stream`]) sending on the LINK_OUT port (a [`ByteSink`]).
 //!
 //! A program drives [`FabricDevice`] exactly as it drives the RTL: it writes the
-//! configuration registers, arms a frame with CONTROL.FRAME_ARM, offers pixels on PIXEL_IN,
-//! polls STATUS and drains the FIFOs by reading POINT_FIFO_* and SOBEL_FIFO_*. Behind the
-//! registers sits any datapath ([`FrontEnd`]): the register-level model, the fast path,
-//! [`crate::fabric::FabricModel`] choosing between them at run time, or a test's script.
+//! configuration registers, arms a frame with CONTROL.FRAME_ARM, offers pixels on PIXEL_IN
+//! and polls STATUS; the stream engine (STREAM_CONTROL.ENABLE) sends the frame's packets, or,
+//! with the engine disabled, the program drains the FIFOs by reading POINT_FIFO_* and
+//! SOBEL_FIFO_*. Behind the registers sits any datapath ([`FrontEnd`]): the register-level
+//! model, the fast path, [`crate::fabric::FabricModel`] choosing between them at run time, or
+//! a test's script.
 //!
 //! # Registers, as `sc_regs` and `sc_fabric` define them
 //! - `rw` configuration lives in a [`RegisterBank`]: the map's masks and reset values, so
@@ -29,20 +32,48 @@
 //! not ready are lost, and pixels before the first one with SOF are discarded. The SOF pixel
 //! is pixel (0, 0) and the frame is the next WIDTH x HEIGHT pixels (lines are counted by
 //! WIDTH; EOL is not checked). After its last pixel the datapath flushes on blanking clocks
-//! until it has emitted everything: BUSY falls, FRAME_DONE is set and FRAME_COUNT counts it.
+//! until it has emitted everything; the stream engine, when enabled, sends what the frame
+//! still holds and `FrameEnd`; then BUSY falls, FRAME_DONE is set and FRAME_COUNT counts it.
+//! The stream engine takes the FIFOs at the end of each line time, in both time models
+//! below, so its packets are the same whichever model and datapath run.
 //! SOFT_RESET empties both FIFOs, stops the frame and clears STATUS, the counters, the
 //! latency and the holding registers; the configuration registers keep their values.
 //!
-//! # Time
-//! The device has no clock of its own: a clock passes for every pixel offered while a frame
-//! runs and for every idle clock of [`PixelIn::idle`]; register accesses fall between clocks.
-//! The datapath is fed whole lines (a line offered in pieces is gathered first), and the
-//! blanking clocks after a frame's last pixel reach it a line time (WIDTH clocks) at a time,
-//! since the fast path works by lines; idle clocks inside a frame only delay it.
-//! LATENCY_CLOCKS is the clock, counted from the frame's first pixel, at which the last
-//! configured octave takes its first input: the register-level model's figure
+//! # Two time models
+//! The device keeps one state and one register decoding, and offers two ways of passing time.
+//!
+//! **Ideal** ([`RegisterBus`], [`PixelIn`]): what programs use (the driver, the host's
+//! in-process device, the firmware under QEMU), with any datapath. The device has no clock
+//! of its own: a clock passes for every pixel offered while a frame runs and for every idle
+//! clock of [`PixelIn::idle`]; register accesses fall between clocks and act at once (a
+//! FRAME_ARM write arms, a SOFT_RESET write resets, before the next access). The datapath is
+//! fed whole lines (a line offered in pieces is gathered first), and the blanking clocks
+//! after a frame's last pixel reach it a line time (WIDTH clocks) at a time, since the fast
+//! path works by lines; idle clocks inside a frame only delay it. LATENCY_CLOCKS is the
+//! clock, counted from the frame's first pixel, at which the last configured octave takes its
+//! first input: the register-level model's figure for back-to-back pixels
 //! ([`latency::first_pixel_of_last_octave`], checked against the model's clocks by
-//! `tests/latency.rs`), stored once that many clocks have passed.
+//! `tests/latency.rs`), stored once that many clocks have passed. This costs a program
+//! nothing per clock, and what it observes matches the RTL register for register.
+//!
+//! **Clock-exact** ([`FabricDevice::clock`], for a datapath that works per clock:
+//! [`ClockedFrontEnd`], the register-level model): one call is one `sc_fabric` clock with an
+//! optional PIXEL_IN beat and an optional bus access, in the RTL's order of effects, so that
+//! a co-simulation can compare every read with the Verilated `sc_fabric`
+//! (`tests/tests/rtl_fabric_contract.rs`). The read's value is sampled before the clock's
+//! edge, as `bus_rdata` captures it; the clock's pushes meet the FIFOs as they were before
+//! the edge's pop; CONTROL's strobes act on the next clock, as `sc_regs` registers them
+//! (with what `sc_fabric` shows on that clock, below); a STATUS flag set and cleared on the
+//! same clock stays set; LATENCY_CLOCKS counts real clocks, pixel or not, from the frame's
+//! first pixel to the last octave's first input.
+//!
+//! # What a read on a strobe's clock shows
+//! `sc_regs` registers CONTROL's strobes, so FRAME_ARM and SOFT_RESET act on the clock after
+//! their write. `sc_fabric` makes a read on that clock agree with the write, so a driver may
+//! read on the very next clock: STATUS.BUSY is 1 from the clock after an accepted FRAME_ARM,
+//! and on SOFT_RESET's clock everything it clears reads cleared (levels, counters,
+//! LATENCY_CLOCKS, FIFO heads, holding registers, BUSY), except STATUS's sticky flags, which
+//! `sc_regs` holds and which clear at that clock's end.
 //!
 //! # FIFO order
 //! Both FIFOs hold their entries in the RTL's order, whichever datapath is behind the device:
@@ -52,8 +83,13 @@
 //! same registers between the same line times pops the same words and sees the same drops
 //! from either datapath (`tests/fifo_order.rs`).
 //!
-//! What a program can observe therefore matches the RTL register for register, but not clock
-//! for clock: the entries a line time brings arrive together at its end.
+//! Through the ideal time model, what a program can observe therefore matches the RTL
+//! register for register, but not clock for clock: the entries a line time brings arrive
+//! together at its end. Through the clock-exact one it matches clock for clock.
+
+mod clock;
+
+pub use clock::{Access, Beat, Clocked};
 
 use stereocal_hdl::regs::stream_fault::Cause;
 use stereocal_hdl::regs::{
@@ -68,6 +104,8 @@ use stereocal_wire::Camera;
 use crate::fabric::config::Config;
 use crate::fabric::fifo_words::{point_words, sobel_words, SOBEL_OFFSETS};
 use crate::fabric::latency;
+#[cfg(doc)]
+use crate::fabric::output::ClockedFrontEnd;
 use crate::fabric::output::{FrontEnd, Overflow};
 use crate::fabric::stream::{StreamEngine, StreamFault, StreamFrame, Unwired};
 use crate::framing::ByteSink;
@@ -89,13 +127,16 @@ enum Phase {
 #[derive(Clone, Copy, Debug)]
 struct Frame {
     width: u16,
+    /// OCTAVES.
+    octaves: u8,
     /// WIDTH x HEIGHT.
     total: u32,
     /// Pixels taken so far.
     taken: u32,
     /// Clocks since the first pixel (the first pixel is clock 0).
     clock: u64,
-    /// LATENCY_CLOCKS of this frame, until it is stored.
+    /// LATENCY_CLOCKS of this frame for back-to-back pixels, until it is stored (the
+    /// clock-exact time model stores the clock it measures instead).
     latency: Option<u64>,
     /// Blanking clocks not yet handed to the datapath (less than a line).
     blank: u32,
@@ -122,6 +163,38 @@ pub struct FabricDevice<F, const W0: usize = 1280, L = Unwired> {
     point_hold: [u32; 2],
     /// SOBEL_FIFO_POSITION.
     sobel_hold: u32,
+    /// CONTROL's strobes as `sc_regs` holds them on this clock (the clock-exact time model;
+    /// the ideal one acts on a write at once and leaves them clear).
+    strobes: Strobes,
+}
+
+/// CONTROL's `wo` strobes: what the last CONTROL write asked for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Strobes {
+    frame_arm: bool,
+    soft_reset: bool,
+}
+
+/// What a bus read of a word gives, decoded once for both time models.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Sample {
+    /// The word, with no side effect.
+    Word(u32),
+    /// POINT_FIFO_DATA: pops the point FIFO.
+    PopPoint,
+    /// SOBEL_FIFO_DATA: pops the Sobel FIFO.
+    PopSobel,
+}
+
+/// What a bus write asks of the device beyond storing, decoded once for both time models.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Written {
+    /// Stored (configuration, CONTROL.ENABLE) or ignored.
+    Stored,
+    /// CONTROL: ENABLE is stored; these are its strobes.
+    Control(Strobes),
+    /// STATUS: the `w1c` flags written 1.
+    ClearFlags(u32),
 }
 
 impl<F: FrontEnd, const W0: usize> FabricDevice<F, W0, Unwired> {
@@ -144,6 +217,7 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
             phase: Phase::Idle,
             frame: Frame {
                 width: 0,
+                octaves: 0,
                 total: 0,
                 taken: 0,
                 clock: 0,
@@ -158,6 +232,7 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
             latency: 0,
             point_hold: [0; 2],
             sobel_hold: 0,
+            strobes: Strobes::default(),
         }
     }
 
@@ -215,6 +290,7 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
         self.line_len = 0;
         self.frame = Frame {
             width: config.width,
+            octaves: config.octaves,
             total: u32::from(config.width) * u32::from(config.height),
             taken: 0,
             clock: 0,
@@ -251,6 +327,14 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
                 self.frame.latency = None;
             }
         }
+        self.note_drops();
+        if self.phase == Phase::Flush && self.datapath.frame_done() {
+            self.end_frame();
+        }
+    }
+
+    /// Sets the overflow flags for what the datapath dropped since the last look.
+    fn note_drops(&mut self) {
         let drops = self.datapath.overflow();
         if drops.points != self.drops_seen.points {
             self.flags |= status::POINT_OVERFLOW.mask();
@@ -259,12 +343,16 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
             self.flags |= status::SOBEL_OVERFLOW.mask();
         }
         self.drops_seen = drops;
-        if self.phase == Phase::Flush && self.datapath.frame_done() {
-            self.stream.finish(self.datapath.overflow());
-            self.phase = Phase::Idle;
-            self.flags |= status::FRAME_DONE.mask();
-            self.frame_count = self.frame_count.wrapping_add(1);
-        }
+    }
+
+    /// BUSY falls: the stream engine sends what the frame still holds and `FrameEnd`, then
+    /// FRAME_DONE is set and FRAME_COUNT counts the frame.
+    fn end_frame(&mut self) {
+        self.stream.take(&mut self.datapath);
+        self.stream.finish(self.datapath.overflow());
+        self.phase = Phase::Idle;
+        self.flags |= status::FRAME_DONE.mask();
+        self.frame_count = self.frame_count.wrapping_add(1);
     }
 
     /// Feeds the frame's next pixels to the datapath a line at a time.
@@ -359,15 +447,18 @@ fn fault_word(fault: Option<StreamFault>) -> u32 {
         | put(&stream_fault::Y, u32::from(y))
 }
 
-impl<F: FrontEnd, const W0: usize, L: ByteSink> RegisterBus for FabricDevice<F, W0, L> {
-    fn read(&mut self, offset: u16) -> u32 {
+impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
+    /// What a read at `offset` gives now: the register decoding of both time models.
+    fn sample(&mut self, offset: u16) -> Sample {
         let Some(offset) = word(offset) else {
-            return 0;
+            return Sample::Word(0);
         };
-        match offset {
+        Sample::Word(match offset {
             version::OFFSET => version::RESET,
             status::OFFSET => {
-                let busy = u32::from(self.phase != Phase::Idle);
+                // An arm the strobe makes on this clock counts (always clear when ideal).
+                let armed = self.strobes.frame_arm && !self.strobes.soft_reset;
+                let busy = u32::from(self.phase != Phase::Idle || armed);
                 self.flags | (busy << status::BUSY.bits.lsb)
             }
             point_fifo_level::OFFSET => level(self.datapath.point_level()),
@@ -376,10 +467,10 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> RegisterBus for FabricDevice<F, 
             sobel_overflow_count::OFFSET => self.datapath.overflow().sobel,
             frame_count::OFFSET => self.frame_count,
             latency_clocks::OFFSET => self.latency,
-            point_fifo_data::OFFSET => self.pop_point(),
+            point_fifo_data::OFFSET => return Sample::PopPoint,
             point_fifo_dxdy::OFFSET => self.point_hold[0],
             point_fifo_dsdog::OFFSET => self.point_hold[1],
-            sobel_fifo_data::OFFSET => self.pop_sobel(),
+            sobel_fifo_data::OFFSET => return Sample::PopSobel,
             sobel_fifo_position::OFFSET => self.sobel_hold,
             stream_points::OFFSET => self.stream.counts().points,
             stream_sobel_packets::OFFSET => self.stream.counts().sobel_packets,
@@ -387,6 +478,44 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> RegisterBus for FabricDevice<F, 
             stream_fault::OFFSET => fault_word(self.stream.fault()),
             // CONTROL and the configuration: stored; other words read 0.
             _ => self.registers.try_read(offset).unwrap_or(0),
+        })
+    }
+
+    /// Stores a write at `offset` and says what else it asks for: the register decoding of
+    /// both time models.
+    fn store(&mut self, offset: u16, value: u32) -> Written {
+        let Some(offset) = word(offset) else {
+            return Written::Stored;
+        };
+        match offset {
+            control::OFFSET => {
+                let _ = self.registers.try_write(offset, value);
+                Written::Control(Strobes {
+                    frame_arm: value & control::FRAME_ARM.mask() != 0,
+                    soft_reset: value & control::SOFT_RESET.mask() != 0,
+                })
+            }
+            status::OFFSET => Written::ClearFlags(value & status::REGISTER.w1c_mask),
+            stream_control::OFFSET => {
+                let _ = self.registers.try_write(offset, value);
+                self.stream.set_fec(stream_control::FEC.extract(value) != 0);
+                Written::Stored
+            }
+            // The configuration; the bank ignores writes to `ro` bits and unmapped words.
+            _ => {
+                let _ = self.registers.try_write(offset, value);
+                Written::Stored
+            }
+        }
+    }
+}
+
+impl<F: FrontEnd, const W0: usize, L: ByteSink> RegisterBus for FabricDevice<F, W0, L> {
+    fn read(&mut self, offset: u16) -> u32 {
+        match self.sample(offset) {
+            Sample::Word(word) => word,
+            Sample::PopPoint => self.pop_point(),
+            Sample::PopSobel => self.pop_sobel(),
         }
     }
 
@@ -420,28 +549,15 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> RegisterBus for FabricDevice<F, 
         }
     }
 
+    /// The write acts at once (the ideal time model).
     fn write(&mut self, offset: u16, value: u32) {
-        let Some(offset) = word(offset) else {
-            return;
-        };
-        match offset {
-            control::OFFSET => {
-                let _ = self.registers.try_write(offset, value);
-                if value & control::SOFT_RESET.mask() != 0 {
-                    self.soft_reset();
-                } else if value & control::FRAME_ARM.mask() != 0 && self.phase == Phase::Idle {
-                    self.arm();
-                }
+        match self.store(offset, value) {
+            Written::Control(strobes) if strobes.soft_reset => self.soft_reset(),
+            Written::Control(strobes) if strobes.frame_arm && self.phase == Phase::Idle => {
+                self.arm()
             }
-            status::OFFSET => self.flags &= !(value & status::REGISTER.w1c_mask),
-            stream_control::OFFSET => {
-                let _ = self.registers.try_write(offset, value);
-                self.stream.set_fec(stream_control::FEC.extract(value) != 0);
-            }
-            // The configuration; the bank ignores writes to `ro` bits and unmapped words.
-            _ => {
-                let _ = self.registers.try_write(offset, value);
-            }
+            Written::ClearFlags(flags) => self.flags &= !flags,
+            Written::Control(_) | Written::Stored => {}
         }
     }
 }

@@ -57,7 +57,9 @@ pub use config::{Config, ConfigError};
 pub use device::FabricDevice;
 pub use fast::FastFrontEnd;
 pub use model::FabricModel;
-pub use output::{run_frame, Extremum, FrameError, FrontEnd, Overflow, SobelEntry};
+pub use output::{
+    run_frame, ClockedFrontEnd, Extremum, FrameError, FrontEnd, Overflow, SobelEntry,
+};
 pub use pipeline::RegisterFrontEnd;
 pub use probe::{ClockProbe, OctaveProbe};
 pub use sobel_fifo::SobelRun;

@@ -181,10 +181,10 @@ impl<const W: usize> Octave<W> {
     /// With `PROBE`, on a clock the octave is enabled it records its observation signals in
     /// `probe` ([`crate::fabric::probe`]); otherwise `probe` is left as it is (the caller
     /// resets it). Without `PROBE` (the benchmarked path) nothing is recorded.
-    pub fn clock<const W0: usize, const PROBE: bool>(
+    pub fn clock<const W0: usize, const POINTS: usize, const PROBE: bool>(
         &mut self,
         input: Option<u16>,
-        out: &mut OutputFifos<W0>,
+        out: &mut OutputFifos<W0, POINTS>,
         probe: &mut OctaveProbe,
     ) -> Option<u16> {
         let flushing = self.taken == self.total && !self.done();

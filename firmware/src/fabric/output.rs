@@ -95,26 +95,27 @@ impl Overflow {
 /// Capacity of the point FIFO: the register map's `point_fifo_depth`.
 pub const POINT_FIFO_CAPACITY: usize = stereocal_hdl::regs::POINT_FIFO_DEPTH as usize;
 
-// The point FIFO is 8 line memories of 64 entries (`OutputFifos::points`), the Sobel FIFO 3
-// lines of octave 0: at the map's widest line that is the map's `sobel_fifo_depth`.
-const _: () = assert!(POINT_FIFO_CAPACITY == 64 * 8);
+// The Sobel FIFO is 3 lines of octave 0: at the map's widest line that is the map's
+// `sobel_fifo_depth`.
 const _: () = assert!(3 * stereocal_hdl::regs::MAX_WIDTH == stereocal_hdl::regs::SOBEL_FIFO_DEPTH);
 
-/// The two output FIFOs of a front end whose octave 0 is at most `W0` wide.
+/// The two output FIFOs of a front end whose octave 0 is at most `W0` wide; the point FIFO
+/// holds `POINTS` points (by default the map's `point_fifo_depth`; a co-simulation takes
+/// fewer, so that small frames fill it).
 #[derive(Clone, Debug)]
-pub struct OutputFifos<const W0: usize> {
-    points: LineFifo<Extremum, 64, 8>,
+pub struct OutputFifos<const W0: usize, const POINTS: usize = POINT_FIFO_CAPACITY> {
+    points: LineFifo<Extremum, POINTS, 1>,
     sobel: SobelFifo<W0, 3>,
     overflow: Overflow,
 }
 
-impl<const W0: usize> Default for OutputFifos<W0> {
+impl<const W0: usize, const POINTS: usize> Default for OutputFifos<W0, POINTS> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const W0: usize> OutputFifos<W0> {
+impl<const W0: usize, const POINTS: usize> OutputFifos<W0, POINTS> {
     /// Empty FIFOs.
     pub const fn new() -> Self {
         Self {
@@ -279,6 +280,20 @@ pub trait FrontEnd {
         });
         filled
     }
+}
+
+/// A datapath that advances one fabric clock at a time, as `sc_frontend` does: what
+/// [`crate::fabric::FabricDevice::clock`] needs to be `sc_fabric` clock for clock. The
+/// register-level model is one; the fast path, which works by lines, is not.
+pub trait ClockedFrontEnd: FrontEnd {
+    /// One clock of the started frame; `pixel` is the pixel entering on it (`None`: none).
+    /// The clock's pushes meet the FIFOs as they were before it.
+    fn clock(&mut self, pixel: Option<u8>);
+    /// Whether every configured octave has emitted everything (`sc_frontend`'s `done`).
+    fn octaves_done(&self) -> bool;
+    /// The clock, counting [`ClockedFrontEnd::clock`]s since `start_frame` from 0, on which
+    /// octave `octave` took its first input sample.
+    fn first_input_clock(&self, octave: usize) -> Option<u64>;
 }
 
 /// Runs a whole `config.width x config.height` frame through `fe`, draining the FIFOs after

@@ -3,11 +3,15 @@
 //!
 //! Octave `k` has line memories for `Wk` pixels; the defaults (1280, 640, 320, 160) take any
 //! input up to 1280 wide. Each `Wk` must be at least `ceil(W(k-1) / 2)` and at least 12 (the
-//! alignment FIFOs are sized in whole lines), checked at compile time.
+//! alignment FIFOs are sized in whole lines), checked at compile time. The point FIFO holds
+//! `P` points (by default the map's `point_fifo_depth`).
 
 use crate::fabric::config::{Config, ConfigError, MAX_OCTAVES};
 use crate::fabric::octave::Octave;
-use crate::fabric::output::{Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelEntry};
+use crate::fabric::output::{
+    ClockedFrontEnd, Extremum, FrameError, FrontEnd, OutputFifos, Overflow, SobelEntry,
+    POINT_FIFO_CAPACITY,
+};
 use crate::fabric::probe::ClockProbe;
 use crate::fabric::sobel_fifo::SobelRun;
 
@@ -18,12 +22,13 @@ pub struct RegisterFrontEnd<
     const W1: usize = 640,
     const W2: usize = 320,
     const W3: usize = 160,
+    const P: usize = POINT_FIFO_CAPACITY,
 > {
     o0: Octave<W0>,
     o1: Octave<W1>,
     o2: Octave<W2>,
     o3: Octave<W3>,
-    fifos: OutputFifos<W0>,
+    fifos: OutputFifos<W0, P>,
     config: Option<Config>,
     rows_in: u16,
     clock: u64,
@@ -31,16 +36,16 @@ pub struct RegisterFrontEnd<
     probe: ClockProbe,
 }
 
-impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> Default
-    for RegisterFrontEnd<W0, W1, W2, W3>
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize, const P: usize> Default
+    for RegisterFrontEnd<W0, W1, W2, W3, P>
 {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
-    RegisterFrontEnd<W0, W1, W2, W3>
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize, const P: usize>
+    RegisterFrontEnd<W0, W1, W2, W3, P>
 {
     /// An idle front end.
     pub const fn new() -> Self {
@@ -48,6 +53,7 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
             assert!(W1 >= W0.div_ceil(2) && W2 >= W1.div_ceil(2) && W3 >= W2.div_ceil(2));
             assert!(W0 >= 12 && W1 >= 12 && W2 >= 12 && W3 >= 12);
             assert!(W0 <= u16::MAX as usize);
+            assert!(P >= 1);
         }
         Self {
             o0: Octave::new(0),
@@ -127,16 +133,16 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
         let x0 = pixel.map(|p| (p as u16) << 8);
         note(0, x0);
         let [p0, p1, p2, p3] = &mut self.probe.octaves;
-        let x1 = self.o0.clock::<W0, PROBE>(x0, &mut self.fifos, p0);
+        let x1 = self.o0.clock::<W0, P, PROBE>(x0, &mut self.fifos, p0);
         if n > 1 {
             note(1, x1);
-            let x2 = self.o1.clock::<W0, PROBE>(x1, &mut self.fifos, p1);
+            let x2 = self.o1.clock::<W0, P, PROBE>(x1, &mut self.fifos, p1);
             if n > 2 {
                 note(2, x2);
-                let x3 = self.o2.clock::<W0, PROBE>(x2, &mut self.fifos, p2);
+                let x3 = self.o2.clock::<W0, P, PROBE>(x2, &mut self.fifos, p2);
                 if n > 3 {
                     note(3, x3);
-                    self.o3.clock::<W0, PROBE>(x3, &mut self.fifos, p3);
+                    self.o3.clock::<W0, P, PROBE>(x3, &mut self.fifos, p3);
                 }
             }
         }
@@ -144,8 +150,24 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize>
     }
 }
 
-impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEnd
-    for RegisterFrontEnd<W0, W1, W2, W3>
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize, const P: usize>
+    ClockedFrontEnd for RegisterFrontEnd<W0, W1, W2, W3, P>
+{
+    fn clock(&mut self, pixel: Option<u8>) {
+        self.step::<true>(pixel);
+    }
+
+    fn octaves_done(&self) -> bool {
+        Self::octaves_done(self)
+    }
+
+    fn first_input_clock(&self, octave: usize) -> Option<u64> {
+        Self::first_input_clock(self, octave)
+    }
+}
+
+impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize, const P: usize> FrontEnd
+    for RegisterFrontEnd<W0, W1, W2, W3, P>
 {
     fn start_frame(&mut self, config: &Config) -> Result<(), ConfigError> {
         config.validate(Self::MAX_WIDTHS)?;
