@@ -6,6 +6,8 @@
 
 use core::ptr;
 
+use crate::softcore::uart::{Ns16550, VIRT_UART0};
+
 /// Base address of the `sifive_test` device on QEMU's `virt` machine.
 pub const VIRT_TEST: usize = 0x0010_0000;
 
@@ -36,12 +38,15 @@ impl ExitCode {
     }
 }
 
-/// Ends the simulation with `code`.
+/// Ends the simulation with `code`, once the link's last bytes have left the UART (the
+/// finisher stops the machine at once, and bytes still in the transmitter would be lost).
 ///
 /// # Safety
 /// [`VIRT_TEST`] must be the `sifive_test` device (true on QEMU `virt`); on other machines the
 /// write lands wherever that address maps.
 pub unsafe fn exit(code: ExitCode) -> ! {
+    // SAFETY: the finisher's machine, QEMU `virt`, has its NS16550 at VIRT_UART0.
+    unsafe { Ns16550::new(VIRT_UART0) }.flush();
     // SAFETY: the caller guarantees the device is there; the write is its whole protocol.
     unsafe { ptr::write_volatile(VIRT_TEST as *mut u32, code.finisher_word()) };
     // QEMU stops at the write; real silicon without the device parks here.

@@ -23,6 +23,8 @@ const LSR: usize = 5;
 const LSR_DATA_READY: u8 = 1 << 0;
 /// LSR: the transmit holding register can take a byte.
 const LSR_THR_EMPTY: u8 = 1 << 5;
+/// LSR: the holding and the shift register are both empty: every byte has left.
+const LSR_TX_EMPTY: u8 = 1 << 6;
 /// LCR: 8 data bits, no parity, one stop bit.
 const LCR_8N1: u8 = 0b0000_0011;
 
@@ -73,6 +75,15 @@ impl Ns16550 {
             core::hint::spin_loop();
         }
         self.write_reg(RBR_THR, byte);
+    }
+
+    /// Waits until every byte written has left the transmitter. THR empty only means the
+    /// next byte may be written while the last one is still shifting out (under QEMU, still
+    /// waiting for the host to read the socket); a program that stops must wait for this.
+    pub fn flush(&mut self) {
+        while self.read_reg(LSR) & LSR_TX_EMPTY == 0 {
+            core::hint::spin_loop();
+        }
     }
 
     /// Sends every byte of `bytes` in order.
