@@ -1,6 +1,7 @@
 //! The firmware ELF under QEMU against the in-process device: identical UART bytes and
 //! identical estimates for synthetic and real frames, `stereocal hil`'s summary equal to
-//! `eval`'s, deterministic instruction counts, and failures named (exit code, timeout).
+//! `eval`'s, deterministic instruction counts, the soft-core's budget per 640x480 pair, and
+//! failures named (exit code, timeout).
 //!
 //! Needs `qemu-system-riscv32` and builds the ELF itself (see the crate docs); every test
 //! takes seconds (small frames, few of them). Run: `cargo test --release -p stereocal-hil
@@ -202,6 +203,55 @@ fn qemu_instructions_per_pixel_640x240_are_deterministic() {
             second[usize::from(r.camera)].uart_wait
         );
     }
+}
+
+/// The soft-core program's own instructions per 640x480 stereo pair (both cameras' driver
+/// counts, without the fabric's software stand-in and the UART waits) fit a 100 MHz
+/// single-issue core at 60 Hz: at most 1,600,000, in both Sobel modes.
+fn softcore_budget(test: &str, sobel_output: SobelOutput) {
+    const BUDGET: u64 = 1_600_000;
+    let Some(qemu) = qemu_or_skip(test) else {
+        return;
+    };
+    let qemu = QemuConfig {
+        count_instructions: true,
+        ..qemu
+    };
+    let config = SessionConfig {
+        sobel_output,
+        ..SessionConfig::default()
+    };
+    let scenario = Scenario::synthetic(SceneKind::Road, 640, 480, 1, config);
+    let (outcome, run) = run_qemu(&scenario, &qemu).unwrap_or_else(|e| panic!("{test}: {e}"));
+    assert!(
+        outcome.records[0].status.has_estimate(),
+        "{test}: no estimate"
+    );
+    let reports = instruction_reports(&run.logs);
+    assert_eq!(
+        reports.len(),
+        2,
+        "{test}: one report per camera: {reports:?}"
+    );
+    let per_pair: u64 = reports.iter().map(|r| r.driver).sum();
+    eprintln!(
+        "{test}: {per_pair} soft-core instructions per pair ({:.3} per pixel), budget {BUDGET}",
+        per_pair as f64 / (2.0 * 640.0 * 480.0)
+    );
+    assert!(per_pair <= BUDGET, "{test}: {per_pair} > {BUDGET}");
+}
+
+#[test]
+fn qemu_softcore_budget_640x480_sobel_rows() {
+    softcore_budget("qemu_softcore_budget_640x480_sobel_rows", SobelOutput::Rows);
+}
+
+#[test]
+fn qemu_softcore_budget_640x480_sobel_patches() {
+    softcore_budget(
+        "qemu_softcore_budget_640x480_sobel_patches",
+        SobelOutput::Patches,
+    );
 }
 
 /// A frame the firmware cannot run ends QEMU with the firmware's exit code, and the error

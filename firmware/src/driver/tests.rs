@@ -310,6 +310,20 @@ impl FrontEnd for Scripted {
             .drain(..n)
             .for_each(|p| sink(SobelRun::single(&p)));
     }
+
+    fn drain_sobel_by_octave(
+        &mut self,
+        _stash: &mut [[u32; 2]],
+        sink: &mut dyn FnMut(SobelRun<'_>),
+    ) {
+        for octave in 0..4 {
+            self.sobel_fifo
+                .iter()
+                .filter(|p| p.octave == octave)
+                .for_each(|p| sink(SobelRun::single(p)));
+        }
+        self.sobel_fifo.clear();
+    }
 }
 
 type ScriptedDriver = Driver<Watched<FabricDevice<Scripted, 64, Collect>>, 64>;
@@ -847,6 +861,13 @@ fn a_fabric_emitting_out_of_order_is_an_error() {
         }
         fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
             self.0.drain_sobel(max, sink)
+        }
+        fn drain_sobel_by_octave(
+            &mut self,
+            stash: &mut [[u32; 2]],
+            sink: &mut dyn FnMut(SobelRun<'_>),
+        ) {
+            self.0.drain_sobel_by_octave(stash, sink)
         }
     }
     let mut driver: Driver<FabricDevice<Backwards, 64, Collect>, 64> = Driver::new(

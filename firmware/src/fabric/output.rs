@@ -168,6 +168,17 @@ impl<const W0: usize, const POINTS: usize> OutputFifos<W0, POINTS> {
         self.sobel.drain(max, sink);
     }
 
+    /// Hands every queued Sobel pixel to `sink` in row runs, octave by octave (octave 0
+    /// first), each octave's in FIFO order, and removes them; `stash` is room to set pixels
+    /// aside ([`SobelFifo::drain_by_octave`]).
+    pub fn drain_sobel_by_octave(
+        &mut self,
+        stash: &mut [[u32; 2]],
+        sink: &mut dyn FnMut(SobelRun<'_>),
+    ) {
+        self.sobel.drain_by_octave(stash, sink);
+    }
+
     /// Copies the words of the oldest `max` queued Sobel pixels (all, and no more than
     /// `words` holds, if fewer) into `words`, two per pixel, and removes them; returns how
     /// many pixels.
@@ -267,6 +278,12 @@ pub trait FrontEnd {
     /// Hands the oldest `max` queued Sobel pixels (all, if fewer) to `sink`, oldest first, in
     /// runs of consecutive pixels of one row, and removes them.
     fn drain_sobel(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>));
+    /// Hands every queued Sobel pixel to `sink` in runs of one row, octave 0's first, then
+    /// octave 1's, 2's and 3's, each octave's in FIFO order, and removes them (what the
+    /// stream engine takes at a line time). `stash` is the caller's room for two words per
+    /// pixel set aside; a FIFO queueing more than it holds takes more passes, not fewer
+    /// pixels.
+    fn drain_sobel_by_octave(&mut self, stash: &mut [[u32; 2]], sink: &mut dyn FnMut(SobelRun<'_>));
     /// Writes the register words of the oldest `max` queued Sobel pixels (all, and no more
     /// than `words` holds, if fewer), two per pixel as [`sobel_run_words`] gives them, to the
     /// front of `words` and removes them; returns how many pixels. The fabric device serves

@@ -12,6 +12,9 @@
 //! Every access is checked (`get`, iterators), so the firmware links no panicking path
 //! through here (tests/tests/firmware_panic_free.rs).
 
+use crate::fabric::config::MAX_OCTAVES;
+use stereocal_hdl::regs::{sobel_fifo_data as sdata, sobel_fifo_position as spos};
+
 use crate::fabric::fifo_words::{sobel_from_words, SobelRowWords};
 use crate::fabric::output::SobelEntry;
 
@@ -251,6 +254,48 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
             sink(gathered(&first, n, &magnitude, &orientation));
         }
     }
+    /// Hands every queued pixel to `sink` in runs, octave 0's first, then octave 1's, 2's
+    /// and 3's, each octave's pixels in FIFO order, and empties the FIFO: the order in which
+    /// the stream engine stores a line time's pixels (one row ring per octave, so only the
+    /// order within an octave matters to it), and long runs where the FIFO interleaves the
+    /// octaves clock by clock. `stash` is the caller's room for setting the deeper octaves'
+    /// pixels aside: with room for every queued pixel, one pass over the FIFO and one per
+    /// deeper octave over what was set aside; with less, a pass over the FIFO per octave.
+    pub fn drain_by_octave(&mut self, stash: &mut [[u32; 2]], sink: &mut dyn FnMut(SobelRun<'_>)) {
+        let ring = self.words.as_flattened();
+        let (after, before) = ring
+            .split_at_checked(self.head)
+            .map_or((ring, &[][..]), |(b, a)| (a, b));
+        let first = after.get(..self.len.min(after.len())).unwrap_or_default();
+        let second = before.get(..self.len - first.len()).unwrap_or_default();
+        let queued = || first.iter().chain(second);
+        if stash.len() < self.len {
+            // No room to set pixels aside: a pass over the FIFO per octave.
+            for octave in 0..MAX_OCTAVES as u32 {
+                runs_of(octave, queued(), sink);
+            }
+        } else {
+            // Octave 0's pixels (most of them) go out on the one pass over the FIFO; the
+            // deeper octaves' are set aside, in order, for a pass each over what was set
+            // aside.
+            let mut stashed = 0;
+            let mut runs = OctaveRuns::new(0);
+            for &[data, position] in queued() {
+                if sdata::OCTAVE.extract(data) == 0 {
+                    runs.push(data, position, sink);
+                } else if let Some(slot) = stash.get_mut(stashed) {
+                    *slot = [data, position];
+                    stashed += 1;
+                }
+            }
+            runs.flush(sink);
+            let stash = stash.get(..stashed).unwrap_or_default();
+            for octave in 1..MAX_OCTAVES as u32 {
+                runs_of(octave, stash.iter(), sink);
+            }
+        }
+        self.clear();
+    }
 }
 
 /// Enqueues pixels into a [`SobelFifo`] ([`SobelFifo::append`]); the FIFO takes them, and
@@ -335,6 +380,81 @@ impl Drop for SobelAppend<'_> {
     }
 }
 
+/// Hands the runs of `octave`'s pixels among `words` to `sink`.
+fn runs_of<'a>(
+    octave: u32,
+    words: impl Iterator<Item = &'a [u32; 2]>,
+    sink: &mut dyn FnMut(SobelRun<'_>),
+) {
+    let mut runs = OctaveRuns::new(octave as u8);
+    for &[data, position] in words {
+        if sdata::OCTAVE.extract(data) == octave {
+            runs.push(data, position, sink);
+        }
+    }
+    runs.flush(sink);
+}
+
+/// The runs of one octave's pixels, gathered from their register words.
+struct OctaveRuns {
+    octave: u8,
+    magnitude: [u8; DRAIN_RUN],
+    orientation: [u8; DRAIN_RUN],
+    /// The run's first position word and its length.
+    start: u32,
+    n: usize,
+}
+
+impl OctaveRuns {
+    fn new(octave: u8) -> Self {
+        Self {
+            octave,
+            magnitude: [0; DRAIN_RUN],
+            orientation: [0; DRAIN_RUN],
+            start: 0,
+            n: 0,
+        }
+    }
+
+    /// Adds the pixel of these words, handing the run to `sink` first when the pixel does
+    /// not continue it (another row, a gap, a full buffer). The position word is `y` above
+    /// `x`, so the next column of the row is the next word, unless `x` would wrap.
+    #[inline]
+    fn push(&mut self, data: u32, position: u32, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        let continues = self.n > 0
+            && self.n < DRAIN_RUN
+            && spos::X.extract(self.start) as usize + self.n <= spos::X.bits.max_value() as usize
+            && position == self.start.wrapping_add(self.n as u32);
+        if !continues {
+            self.flush(sink);
+            self.start = position;
+        }
+        if let (Some(m), Some(o)) = (
+            self.magnitude.get_mut(self.n),
+            self.orientation.get_mut(self.n),
+        ) {
+            *m = sdata::MAGNITUDE.extract(data) as u8;
+            *o = sdata::ORIENTATION.extract(data) as u8;
+        }
+        self.n += 1;
+    }
+
+    /// Hands the run gathered so far to `sink`.
+    fn flush(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
+        if self.n == 0 {
+            return;
+        }
+        sink(SobelRun {
+            octave: self.octave,
+            y: spos::Y.extract(self.start) as u16,
+            x: spos::X.extract(self.start) as u16,
+            magnitude: self.magnitude.get(..self.n).unwrap_or_default(),
+            orientation: self.orientation.get(..self.n).unwrap_or_default(),
+        });
+        self.n = 0;
+    }
+}
+
 /// The run of `n` pixels from `first` whose values are the front of `magnitude` and
 /// `orientation`.
 fn gathered<'a>(
@@ -382,6 +502,8 @@ mod tests {
         },
         Pop,
         Drain,
+        /// Every pixel, octave by octave, with this much room to set pixels aside.
+        DrainByOctave(usize),
         /// At most this many pixels as words.
         DrainWords(usize),
     }
@@ -405,12 +527,14 @@ mod tests {
                 .prop_map(|(octave, y, x, len, seed)| Step::Run { octave, y, x, len, seed }),
             2 => Just(Step::Pop),
             1 => Just(Step::Drain),
+            1 => (0usize..=48).prop_map(Step::DrainByOctave),
             1 => (0usize..60).prop_map(Step::DrainWords),
         ]
     }
 
     proptest! {
-        /// Pushes, runs, pops and drains (as runs or as words) give the pixels, drops and
+        /// Pushes, runs, pops and drains (as runs, octave by octave or as words) give the
+        /// pixels, drops and
         /// lengths of a plain FIFO of pixel records with the same capacity, whatever the
         /// wrapping; every run is consecutive pixels of one row and none is empty.
         #[test]
@@ -446,6 +570,20 @@ mod tests {
                         });
                         let mut from_records = Vec::new();
                         records.drain_slices(&mut |s| from_records.extend_from_slice(s));
+                        prop_assert_eq!(from_runs, from_records);
+                    }
+                    Step::DrainByOctave(room) => {
+                        let mut from_runs = Vec::new();
+                        let mut stash = [[0; 2]; 48];
+                        let stash = &mut stash[..room];
+                        runs.drain_by_octave(stash, &mut |run| {
+                            assert!(!run.is_empty());
+                            from_runs.extend(run.pixels());
+                        });
+                        let mut from_records = Vec::new();
+                        records.drain_slices(&mut |s| from_records.extend_from_slice(s));
+                        // A stable sort: each octave's pixels keep their FIFO order.
+                        from_records.sort_by_key(|p| p.octave);
                         prop_assert_eq!(from_runs, from_records);
                     }
                     Step::DrainWords(max) => {

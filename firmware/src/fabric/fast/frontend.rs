@@ -319,6 +319,14 @@ impl<const W0: usize, const W1: usize, const W2: usize, const W3: usize> FrontEn
         self.fifos.drain_sobel(max, sink);
     }
 
+    fn drain_sobel_by_octave(
+        &mut self,
+        stash: &mut [[u32; 2]],
+        sink: &mut dyn FnMut(SobelRun<'_>),
+    ) {
+        self.fifos.drain_sobel_by_octave(stash, sink);
+    }
+
     fn drain_sobel_words(&mut self, max: usize, words: &mut [u32]) -> usize {
         self.fifos.drain_sobel_words(max, words)
     }

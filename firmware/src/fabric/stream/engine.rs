@@ -78,6 +78,15 @@ struct Sending {
 /// The stream engine of one camera channel whose octave 0 is at most `W0` pixels wide,
 /// sending on the link `L` (its LINK_OUT port).
 pub struct StreamEngine<const W0: usize, L> {
+    out: Output<W0, L>,
+    /// Room for the deeper octaves' pixels of a line time while octave 0's are stored first
+    /// (`FrontEnd::drain_sobel_by_octave`): as many as the Sobel FIFO holds, 3 lines of
+    /// octave 0 (the map's `sobel_fifo_depth`), two words each.
+    stash: [[[u32; 2]; W0]; 3],
+}
+
+/// Everything of the engine but its stash: what turns the records into packets.
+struct Output<const W0: usize, L> {
     link: L,
     framer: Framer,
     numbering: Numbering,
@@ -94,62 +103,67 @@ impl<const W0: usize, L: ByteSink> StreamEngine<W0, L> {
     /// An idle engine on `link`, its first packet numbered 0.
     pub fn new(link: L) -> Self {
         Self {
-            link,
-            framer: Framer::new(),
-            numbering: Numbering::new(Source::channel(Camera::Left)),
-            sending: None,
-            counts: StreamCounts::default(),
-            fault: None,
-            ring: SobelRing::new(),
-            patches: PatchQueue::new(),
-            batch: PointBatch::new(),
-            patch: [SobelPixel::default(); PATCH_PIXELS],
+            out: Output {
+                link,
+                framer: Framer::new(),
+                numbering: Numbering::new(Source::channel(Camera::Left)),
+                sending: None,
+                counts: StreamCounts::default(),
+                fault: None,
+                ring: SobelRing::new(),
+                patches: PatchQueue::new(),
+                batch: PointBatch::new(),
+                patch: [SobelPixel::default(); PATCH_PIXELS],
+            },
+            stash: [[[0; 2]; W0]; 3],
         }
     }
 
     /// The link the engine sends on.
     pub fn link(&self) -> &L {
-        &self.link
+        &self.out.link
     }
 
     /// The link, mutably (to take what the engine sent).
     pub fn link_mut(&mut self) -> &mut L {
-        &mut self.link
+        &mut self.out.link
     }
 
     /// STREAM_CONTROL.FEC: whether the link frames sent from now on carry parity.
     pub fn set_fec(&mut self, on: bool) {
-        self.framer.set_fec(on);
+        self.out.framer.set_fec(on);
     }
 
     /// Whether a frame is being sent (between its FRAME_ARM and its end or a soft reset).
     pub fn is_sending(&self) -> bool {
-        self.sending.is_some()
+        self.out.sending.is_some()
     }
 
     /// The current (or last) frame's counters.
     pub fn counts(&self) -> StreamCounts {
-        self.counts
+        self.out.counts
     }
 
     /// Why the current (or last) frame stopped, if it did.
     pub fn fault(&self) -> Option<StreamFault> {
-        self.fault
+        self.out.fault
     }
 
     /// FRAME_ARM with the engine enabled: zeroes the counters and sends `FrameStart`.
     /// `drops` are the datapath's drop counters now, the base of `FrameEnd`'s.
     pub fn start(&mut self, frame: StreamFrame, drops: Overflow) {
         let source = Source::channel(frame.camera);
-        if self.numbering.source() != source {
-            self.numbering = Numbering::new(source);
+        if self.out.numbering.source() != source {
+            self.out.numbering = Numbering::new(source);
         }
-        self.counts = StreamCounts::default();
-        self.fault = None;
-        self.ring.start(frame.width, frame.height, frame.octaves);
-        self.patches.clear();
-        self.batch.start(frame.points_per_batch);
-        self.sending = Some(Sending {
+        self.out.counts = StreamCounts::default();
+        self.out.fault = None;
+        self.out
+            .ring
+            .start(frame.width, frame.height, frame.octaves);
+        self.out.patches.clear();
+        self.out.batch.start(frame.points_per_batch);
+        self.out.sending = Some(Sending {
             frame,
             drops_at_arm: drops,
         });
@@ -161,37 +175,38 @@ impl<const W0: usize, L: ByteSink> StreamEngine<W0, L> {
             octaves: frame.octaves,
             timestamp_us: frame.timestamp_us,
         });
-        self.send_or_fault(&start);
+        self.out.send_or_fault(&start);
     }
 
     /// SOFT_RESET: the frame is abandoned without a `FrameEnd`; the counters and the fault
     /// read 0. The numbering goes on, so the host sees the abandoned frame's end as lost.
     pub fn abort(&mut self) {
-        self.sending = None;
-        self.counts = StreamCounts::default();
-        self.fault = None;
+        self.out.sending = None;
+        self.out.counts = StreamCounts::default();
+        self.out.fault = None;
     }
 
-    /// Takes every entry the datapath's FIFOs hold, points first, and sends what they make
-    /// ready. With no frame being sent the FIFOs are left to the bus; after a fault the
+    /// Takes every entry the datapath's FIFOs hold, points first, then the Sobel pixels
+    /// octave by octave, and sends what they make ready. With no frame being sent the FIFOs are left to the bus; after a fault the
     /// frame's entries are taken and discarded.
     pub fn take<F: FrontEnd + ?Sized>(&mut self, datapath: &mut F) {
-        if self.sending.is_none() {
+        if self.out.sending.is_none() {
             return;
         }
+        let Self { out, stash } = self;
         datapath.drain_points(&mut |points| {
             for point in points {
-                if self.fault.is_none() {
-                    if let Err(fault) = self.on_point(point) {
-                        self.fault = Some(fault);
+                if out.fault.is_none() {
+                    if let Err(fault) = out.on_point(point) {
+                        out.fault = Some(fault);
                     }
                 }
             }
         });
-        datapath.drain_sobel(usize::MAX, &mut |run| {
-            if self.fault.is_none() {
-                if let Err(fault) = self.on_sobel(run) {
-                    self.fault = Some(fault);
+        datapath.drain_sobel_by_octave(stash.as_flattened_mut(), &mut |run| {
+            if out.fault.is_none() {
+                if let Err(fault) = out.on_sobel(run) {
+                    out.fault = Some(fault);
                 }
             }
         });
@@ -201,18 +216,20 @@ impl<const W0: usize, L: ByteSink> StreamEngine<W0, L> {
     /// last points and `FrameEnd` (none after a fault). `drops` are the datapath's drop
     /// counters now.
     pub fn finish(&mut self, drops: Overflow) {
-        let Some(sending) = self.sending.take() else {
+        let Some(sending) = self.out.sending.take() else {
             return;
         };
-        if self.fault.is_some() {
+        if self.out.fault.is_some() {
             return;
         }
-        if let Err(fault) = self.flush(&sending) {
-            self.fault = Some(fault);
+        if let Err(fault) = self.out.flush(&sending) {
+            self.out.fault = Some(fault);
             return;
         }
         let overflow = drops.since(sending.drops_at_arm);
-        let dropped_sobel = overflow.sobel.saturating_add(self.counts.patches_dropped);
+        let dropped_sobel = overflow
+            .sobel
+            .saturating_add(self.out.counts.patches_dropped);
         let mut flags = FrameEndFlags(0);
         if overflow.points > 0 {
             flags = flags | FrameEndFlags::POINT_FIFO_OVERFLOW;
@@ -223,15 +240,17 @@ impl<const W0: usize, L: ByteSink> StreamEngine<W0, L> {
         let end = PacketRepr::FrameEnd(FrameEndRepr {
             frame_id: sending.frame.frame_id,
             camera: sending.frame.camera,
-            point_count: self.counts.points,
-            sobel_count: self.counts.sobel_packets,
+            point_count: self.out.counts.points,
+            sobel_count: self.out.counts.sobel_packets,
             flags,
             dropped_points: overflow.points,
             dropped_sobel,
         });
-        self.send_or_fault(&end);
+        self.out.send_or_fault(&end);
     }
+}
 
+impl<const W0: usize, L: ByteSink> Output<W0, L> {
     /// The rows each octave still has open, the patches still waiting, the last points.
     fn flush(&mut self, sending: &Sending) -> Result<(), StreamFault> {
         for completed in self.ring.finish().into_iter().flatten() {

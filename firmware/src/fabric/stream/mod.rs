@@ -20,8 +20,10 @@
 //! implementation (the model here over either datapath, the RTL, a soft-core of any speed)
 //! sends the same bytes: at the end of each line time (the clock after a frame's line of
 //! WIDTH pixels has entered, and every WIDTH blanking clocks after the last line) the engine
-//! takes what the FIFOs hold at that moment, every point first, then every Sobel pixel, each
-//! in FIFO order; entries that arrive while it works wait for the next line time. Points are
+//! takes what the FIFOs hold at that moment, every point first (in FIFO order), then the Sobel
+//! pixels octave by octave, octave 0 first, each octave's in FIFO order (the engine keeps a
+//! row ring per octave, so storing them octave by octave changes no pixel; it fixes the
+//! order in which rows that complete in the same line time leave); entries that arrive while it works wait for the next line time. Points are
 //! batched in arrival order and a batch leaves when it is full; a Sobel row leaves when its
 //! last pixel has been taken (segments in column order); a patch leaves when its point has
 //! arrived and the rows down to `y + 7` are complete, in point order among the patches a row
