@@ -22,7 +22,7 @@ fn texture(w: usize, h: usize) -> Vec<u8> {
 fn frame<F: FrontEnd>(fe: &mut F, cfg: &Config, img: &[u8]) -> usize {
     let mut n = 0usize;
     let mut m = 0usize;
-    // The consumer touches every item (as the driver's packetizer would).
+    // The consumer touches every item (as the stream engine would).
     run_frame(fe, cfg, img, &mut |p| n += p.len(), &mut |s| {
         m += s.magnitude.iter().map(|&m| m as usize).sum::<usize>()
     })

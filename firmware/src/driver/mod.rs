@@ -7,7 +7,8 @@
 //! [`stereocal_hdl::Mmio`] on an FPGA, the device model [`crate::fabric::FabricDevice`] in
 //! software (in the soft-core ELF under QEMU and in the host's in-process link). The frame's
 //! packets leave on the fabric's own link port, framed and numbered by its stream engine as
-//! the camera's source; the driver answers the host's packets through a [`PacketWriter`] of
+//! the camera's source; the driver answers the host's packets through a
+//! [`PacketWriter`](crate::framing::PacketWriter) of
 //! the device's control source:
 //!
 //! ```

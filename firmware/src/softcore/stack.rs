@@ -3,8 +3,8 @@
 //! The stack region is what riscv-rt's linker script leaves between the end of `.bss`/heap
 //! (`__estack`) and `_stack_start` (`__sstack`, the end of the program's RAM in
 //! `firmware/memory.x`); the stack grows down from its top. On the bare-metal target
-//! [`paint`] (first thing in `main`) fills every word of the region below the current stack
-//! pointer with [`PAINT`], and [`high_water`] finds the lowest word that no longer holds it:
+//! `paint` (first thing in `main`) fills every word of the region below the current stack
+//! pointer with [`PAINT`], and `high_water` finds the lowest word that no longer holds it:
 //! the stack reached down to there. `main` takes the mark twice: once when both channels are
 //! built (boot: the constructors build each `Driver` by value in their own frames, the
 //! deepest the stack goes), then it paints again and takes the main loop's mark after the

@@ -170,7 +170,7 @@ fn print_instructions(logs: &[stereocal_tools::hil::DeviceLog]) {
 }
 
 /// The soft-core program's own instructions for the costliest pair of the run: both cameras'
-/// `driver` counts (configuring, arming, draining, packetizing, framing), without the fabric's
+/// `driver` counts (configuring, arming, offering the rows, polling), without the fabric's
 /// software stand-in (`front_end`) and without the waits for the emulated UART, which a
 /// link that keeps up does not cause. The budget is per pair, so the worst pair is the figure.
 fn softcore_instructions_per_pair(logs: &[stereocal_tools::hil::DeviceLog]) -> Option<u64> {

@@ -3,7 +3,7 @@
 //! Same integers as the register-level model (plain multiplies replace the LUT distributed
 //! arithmetic: `Σ_b LUT[bits_b] << b` is exactly `Σ_j tap_j · s_j`), same borders, same
 //! streams, pushed into the FIFOs in the pipeline's order at the pipeline's line times
-//! ([`pending`], [`release`]). `tests/bit_exact.rs` proves the streams equal on random and
+//! (`pending.rs`, `release.rs`). `tests/bit_exact.rs` proves the streams equal on random and
 //! real images, `tests/fifo_order.rs` the FIFOs' contents and counters.
 
 mod filter;

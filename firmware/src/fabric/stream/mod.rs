@@ -4,7 +4,7 @@
 //!
 //! At a camera's pixel rate a soft-core has a few instructions per pixel; reading the Sobel
 //! FIFO through registers alone costs more. The engine sits between the FIFOs and the link's
-//! transmitter (the LINK_OUT port) and does per record what the driver did: it batches points
+//! transmitter (the LINK_OUT port) and does per record what a driver would: it batches points
 //! into `PointBatch` packets, assembles every octave's Sobel rows in a ring of
 //! [`RING_ROWS`] rows, and sends them whole or in segments (`SobelRows`) or cuts the 16x16
 //! window around each point (`SobelPatch`); its framer adds the header, CRC-32C, COBS and,

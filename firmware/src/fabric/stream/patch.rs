@@ -4,7 +4,7 @@
 //! fabric's point stream lags its Sobel stream by a few rows, so a point usually arrives with
 //! its top rows already in the [`SobelRing`](crate::fabric::stream::sobel_ring::SobelRing) and waits
 //! for the rows below it. A point whose top rows have already left the ring, or that finds
-//! the queue full, gets no patch; the driver counts it in `FrameEnd.dropped_sobel`.
+//! the queue full, gets no patch; the engine counts it in `FrameEnd.dropped_sobel`.
 
 use heapless::Vec;
 use stereocal_wire::PATCH_SIZE;
