@@ -110,9 +110,10 @@ module sc_fabric #(
     wire [10:0] output_mode_row_segment;
     /* verilator lint_on UNUSEDSIGNAL */
 
-    // The stream engine's registers (docs/STREAM_ENGINE.md). Its RTL block is not written yet:
-    // the Rust model (firmware/src/fabric/stream) defines it, and this fabric behaves as one
-    // whose STREAM_CONTROL.ENABLE is 0 (the FIFOs wait for the bus; the counters read 0).
+    // The stream engine's registers (docs/STREAM_ENGINE.md). Of its RTL only the framer
+    // (sc_framer.v) is written: the Rust model (firmware/src/fabric/stream) defines the rest,
+    // and this fabric behaves as one whose STREAM_CONTROL.ENABLE is 0 (the FIFOs wait for the
+    // bus; the counters read 0).
     /* verilator lint_off UNUSEDSIGNAL */
     wire        stream_control_enable, stream_control_fec;
     wire [7:0]  stream_control_camera;

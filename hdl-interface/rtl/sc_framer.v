@@ -1,0 +1,241 @@
+// sc_framer: the stream engine's framer. It takes a packet's bytes (header and payload, as
+// the wire format lays them out), appends their CRC-32C, COBS-encodes the packet, protects
+// the COBS body by RS(255,239) parity packed seven bits per byte when `fec` was set at the
+// packet's first byte, and ends the link frame with its 0x00 delimiter: the bytes
+// `Framer::send` (firmware/src/framing/sink.rs) writes, byte for byte (shared/docs/
+// wire-format.md, sections 2, 2.1 and 3; tests/tests/rtl_framer.rs compares them).
+//
+// Interfaces: IN (the packet former) and OUT (LINK_OUT) are byte streams with AXI4-stream
+// rules (a byte moves on a clock where VALID and READY are both 1). IN_LAST marks a packet's
+// last byte. A packet is at most MAXLEN - 4 bytes (the wire's MAX_PACKET_LEN minus its CRC);
+// IN_READY stays 0 while a frame is being sent.
+//
+// How: the packet and its CRC go into a byte memory while they arrive (one byte per clock).
+// COBS then works block by block: a scan counts the bytes up to the next zero, the end, or
+// 254 bytes (one clock per byte), the block's code goes out, then its bytes; a zero ends a
+// block and is not sent, a packet ending in a zero gets a last empty block (code 0x01), and
+// a full block (code 0xFF) at the end gets none. Every body byte that goes out also steps the
+// RS shift register (generator (x - 2^0)..(x - 2^15) over GF(2^8) mod 0x11D); each 239
+// bytes, and at the body's end, its 16 parity bytes go to a parity memory. After the body the
+// parity bytes go out seven bits at a time, most significant first, each group with bit 7
+// set, the last group's unused low bits 0; then the delimiter.
+`default_nettype none
+
+module sc_framer #(
+    parameter MAXLEN = 2588              // packet and CRC: MAX_PACKET_LEN
+) (
+    input  wire       clk,
+    input  wire       rst,               // synchronous, active high
+    input  wire       fec,               // protect this packet (sampled at its first byte)
+    input  wire [7:0] in_data,
+    input  wire       in_valid,
+    input  wire       in_last,
+    output wire       in_ready,
+    output reg  [7:0] out_data,
+    output reg        out_valid,
+    input  wire       out_ready
+);
+
+    localparam AW = $clog2(MAXLEN + 1);
+    // Parity memory: 16 bytes per 239-byte block of the largest body (MAXLEN COBS-encoded).
+    localparam BLOCKS = (MAXLEN + MAXLEN / 254 + 2 + 238) / 239;
+    localparam PW = $clog2(16 * BLOCKS + 1);
+    localparam [PW-1:0] ECC = 16;        // parity bytes per block
+
+    localparam [3:0] S_IN = 4'd0,       // taking the packet's bytes
+                     S_CRC = 4'd1,      // storing the 4 CRC bytes
+                     S_SCAN = 4'd2,     // counting the block's bytes
+                     S_CODE = 4'd3,     // sending the block's code
+                     S_DATA = 4'd4,     // sending the block's bytes
+                     S_PARITY = 4'd5,   // the last block's parity into the memory
+                     S_PACK = 4'd6,     // sending the packed parity
+                     S_DELIM = 4'd7;    // sending the delimiter
+
+    reg  [3:0]    state;
+    reg  [7:0]    mem [0:MAXLEN-1];
+    reg  [AW-1:0] n;                    // bytes stored (packet, then packet and CRC)
+    reg  [AW-1:0] p;                    // the block's first byte
+    reg  [7:0]    k;                    // the block's length, 0..254
+    reg  [7:0]    j;                    // bytes of the block sent
+    reg  [1:0]    crc_at;               // CRC byte being stored
+    reg  [31:0]   crc;
+    reg           protect;
+
+    // RS shift register: rs[0] the highest degree; the block's bytes so far.
+    reg  [7:0]    rs [0:15];
+    reg  [7:0]    in_block;             // 0..239
+    reg  [7:0]    par [0:16*BLOCKS-1];
+    reg  [PW-1:0] par_n;                // parity bytes stored
+    reg  [PW-1:0] par_at;               // parity bytes packed
+    reg  [14:0]   bits;                 // packer: bits held, right-aligned
+    reg  [3:0]    held;
+
+    assign in_ready = state == S_IN;
+
+    // ------------------------------------------------------------------------------------
+    // Arithmetic.
+    function [31:0] crc_byte(input [31:0] c, input [7:0] b);
+        integer i;
+        reg [31:0] x;
+        begin
+            x = c ^ {24'd0, b};
+            for (i = 0; i < 8; i = i + 1)
+                x = (x >> 1) ^ (32'h82F6_3B78 & {32{x[0]}});
+            crc_byte = x;
+        end
+    endfunction
+
+    function [7:0] gf_mul(input [7:0] a, input [7:0] b);   // GF(2^8) mod 0x11D
+        integer i;
+        reg [7:0] x, y;
+        begin
+            x = a;
+            y = 8'd0;
+            for (i = 0; i < 8; i = i + 1) begin
+                if (b[i]) y = y ^ x;
+                x = {x[6:0], 1'b0} ^ (x[7] ? 8'h1D : 8'h00);
+            end
+            gf_mul = y;
+        end
+    endfunction
+
+    function [7:0] gen(input integer i);  // generator coefficient of degree 15 - i
+        case (i)
+            0: gen = 8'h3B;  1: gen = 8'h0D;  2: gen = 8'h68;  3: gen = 8'hBD;
+            4: gen = 8'h44;  5: gen = 8'hD1;  6: gen = 8'h1E;  7: gen = 8'h08;
+            8: gen = 8'hA3;  9: gen = 8'h41; 10: gen = 8'h29; 11: gen = 8'hE5;
+           12: gen = 8'h62; 13: gen = 8'h32; 14: gen = 8'h24; default: gen = 8'h3B;
+        endcase
+    endfunction
+
+    // ------------------------------------------------------------------------------------
+    // What goes out now.
+    wire [AW-1:0] at = p + {{(AW-8){1'b0}}, k};          // the byte the scan looks at
+    wire [AW-1:0] data_at = p + {{(AW-8){1'b0}}, j};
+    wire          scan_stops = k == 8'd254 || at >= n || mem[at] == 8'd0;
+    wire          body_byte = (state == S_CODE || state == S_DATA) && out_valid && out_ready;
+    wire [7:0]    fb = out_data ^ rs[0];
+
+    always @(*) begin
+        out_valid = 1'b0;
+        out_data = 8'd0;
+        case (state)
+            S_CODE: begin out_valid = 1'b1; out_data = k + 8'd1; end
+            S_DATA: begin out_valid = j != k; out_data = mem[data_at]; end
+            S_PACK: begin
+                out_valid = held >= 4'd7 || par_at == par_n && held != 4'd0;
+                out_data = held >= 4'd7 ? {1'b1, bits[held - 4'd7 +: 7]}
+                                        : {1'b1, bits[6:0] << (4'd7 - held)};
+            end
+            S_DELIM: out_valid = 1'b1;
+            default: ;
+        endcase
+    end
+
+    integer r;
+    always @(posedge clk) begin
+        if (rst) begin
+            state <= S_IN;
+            n <= {AW{1'b0}};
+            crc <= 32'hFFFF_FFFF;
+        end else begin
+            case (state)
+                S_IN: if (in_valid) begin
+                    if (n == {AW{1'b0}}) protect <= fec;
+                    mem[n] <= in_data;
+                    n <= n + 1'b1;
+                    crc <= crc_byte(crc, in_data);
+                    if (in_last) begin
+                        state <= S_CRC;
+                        crc_at <= 2'd0;
+                    end
+                end
+                S_CRC: begin
+                    mem[n] <= ~crc[8*crc_at +: 8];
+                    n <= n + 1'b1;
+                    crc_at <= crc_at + 2'd1;
+                    if (crc_at == 2'd3) begin
+                        state <= S_SCAN;
+                        p <= {AW{1'b0}};
+                        k <= 8'd0;
+                        in_block <= 8'd0;
+                        par_n <= {PW{1'b0}};
+                        for (r = 0; r < 16; r = r + 1) rs[r] <= 8'd0;
+                    end
+                end
+                S_SCAN: if (scan_stops) state <= S_CODE;
+                        else k <= k + 8'd1;
+                S_CODE: if (out_ready) begin
+                    state <= S_DATA;
+                    j <= 8'd0;
+                end
+                S_DATA: if (j != k) begin
+                    if (out_ready) j <= j + 8'd1;
+                end else if (k == 8'd254) begin
+                    // A full block: the next one starts behind it; none after the last.
+                    p <= at;
+                    k <= 8'd0;
+                    state <= at == n ? S_PARITY : S_SCAN;
+                end else if (at == n) begin
+                    state <= S_PARITY;
+                end else begin
+                    // A zero ended the block: it is not sent; a block follows, if empty.
+                    p <= at + 1'b1;
+                    k <= 8'd0;
+                    state <= S_SCAN;
+                end
+                S_PARITY: begin
+                    if (protect && in_block != 8'd0) begin
+                        for (r = 0; r < 16; r = r + 1) par[par_n + r[PW-1:0]] <= rs[r];
+                        par_n <= par_n + ECC;
+                    end
+                    par_at <= {PW{1'b0}};
+                    bits <= 15'd0;
+                    held <= 4'd0;
+                    state <= protect ? S_PACK : S_DELIM;
+                end
+                S_PACK: begin
+                    if (out_valid) begin
+                        if (out_ready) begin
+                            if (held >= 4'd7) held <= held - 4'd7;
+                            else held <= 4'd0;
+                        end
+                    end else if (par_at != par_n) begin
+                        bits <= {bits[6:0], par[par_at]};
+                        held <= held + 4'd8;
+                        par_at <= par_at + 1'b1;
+                    end else begin
+                        state <= S_DELIM;
+                    end
+                end
+                S_DELIM: if (out_ready) begin
+                    state <= S_IN;
+                    n <= {AW{1'b0}};
+                    crc <= 32'hFFFF_FFFF;
+                end
+                default: state <= S_IN;
+            endcase
+
+            // The RS shift register takes every body byte that goes out.
+            if (body_byte && protect) begin
+                if (in_block == 8'd238) begin
+                    // The block's last byte: its parity goes to the memory, the register
+                    // starts over.
+                    for (r = 0; r < 15; r = r + 1)
+                        par[par_n + r[PW-1:0]] <= rs[r + 1] ^ gf_mul(fb, gen(r));
+                    par[par_n + ECC - 1'b1] <= gf_mul(fb, gen(15));
+                    par_n <= par_n + ECC;
+                    in_block <= 8'd0;
+                    for (r = 0; r < 16; r = r + 1) rs[r] <= 8'd0;
+                end else begin
+                    for (r = 0; r < 15; r = r + 1) rs[r] <= rs[r + 1] ^ gf_mul(fb, gen(r));
+                    rs[15] <= gf_mul(fb, gen(15));
+                    in_block <= in_block + 8'd1;
+                end
+            end
+        end
+    end
+
+endmodule
+
+`default_nettype wire
