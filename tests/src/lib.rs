@@ -25,6 +25,7 @@
 //! the device model's clock-exact entry point and compares every word read over the bus.
 
 pub mod fabric_contract;
+pub mod rng;
 pub mod rtl;
 pub mod rtl_fabric;
 

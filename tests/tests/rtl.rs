@@ -12,6 +12,7 @@
 )]
 
 use stereocal_firmware::fabric::Config;
+use stereocal_hil::rng::Rng;
 
 /// Whether the RTL model exists; prints the loud skip line when it does not.
 fn rtl_available(test: &str) -> bool {
@@ -39,35 +40,19 @@ macro_rules! rtl_test {
     };
 }
 
-/// splitmix64: deterministic test images without an RNG dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
-
 fn noise(w: usize, h: usize, seed: u64) -> Vec<u8> {
-    let mut r = Rng(seed);
-    (0..w * h).map(|_| r.next() as u8).collect()
+    let mut r = Rng::new(seed);
+    (0..w * h).map(|_| r.bits() as u8).collect()
 }
 
 /// Noise with structure: blobs of random brightness on a random background.
 fn blobs(w: usize, h: usize, seed: u64) -> Vec<u8> {
-    let mut r = Rng(seed);
-    let mut img: Vec<u8> = (0..w * h).map(|_| 96 + (r.next() % 32) as u8).collect();
+    let mut r = Rng::new(seed);
+    let mut img: Vec<u8> = (0..w * h).map(|_| 96 + (r.bits() % 32) as u8).collect();
     for _ in 0..(w * h / 40).max(3) {
         let (cx, cy) = (r.below(w as u64) as i64, r.below(h as u64) as i64);
         let rad = 1 + r.below(4) as i64;
-        let v = r.next() as u8;
+        let v = r.bits() as u8;
         for y in (cy - rad).max(0)..(cy + rad + 1).min(h as i64) {
             for x in (cx - rad).max(0)..(cx + rad + 1).min(w as i64) {
                 if (x - cx).pow(2) + (y - cy).pow(2) <= rad * rad {
@@ -264,7 +249,7 @@ rtl_test!(rtl_random_images, {
 rtl_test!(rtl_random_configurations, {
     // Sizes, octave counts and every other setting drawn at random (valid ones only).
     let mut b = sim::Bench::new();
-    let mut r = Rng(0x5eed);
+    let mut r = Rng::new(0x5eed);
     let mut points = 0;
     let mut frames = 0;
     while frames < 40 {
@@ -280,7 +265,7 @@ rtl_test!(rtl_random_configurations, {
         if cfg.validate([1280, 640, 320, 160]).is_err() {
             continue;
         }
-        let seed = r.next();
+        let seed = r.bits();
         let img = match seed % 3 {
             0 => noise(w as usize, h as usize, seed),
             _ => blobs(w as usize, h as usize, seed),
@@ -297,7 +282,7 @@ rtl_test!(rtl_random_with_idle_clocks, {
     let mut b = sim::Bench::new();
     for (w, h, octaves, seed) in [(40u16, 36u16, 4u8, 11u64), (29, 21, 3, 12)] {
         let img = blobs(w as usize, h as usize, seed);
-        let mut r = Rng(seed);
+        let mut r = Rng::new(seed);
         let mut stim = Vec::new();
         for &p in &img {
             for _ in 0..[0, 0, 0, 1, 2, 5][r.below(6) as usize] {

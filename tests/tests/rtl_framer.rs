@@ -13,6 +13,7 @@ use std::path::Path;
 use std::process::Command;
 
 use stereocal_firmware::framing::{ByteSink, Framer, Numbering};
+use stereocal_hil::rng::Rng;
 use stereocal_wire::{
     Camera, FrameEndFlags, FrameEndRepr, FrameStartRepr, PacketRepr, Point, PointBatchRepr,
     Records, SobelPixel, SobelRowsRepr, Source,
@@ -25,23 +26,6 @@ struct Collect(Vec<u8>);
 impl ByteSink for Collect {
     fn write(&mut self, bytes: &[u8]) {
         self.0.extend_from_slice(bytes);
-    }
-}
-
-/// A seeded generator (SplitMix64).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
     }
 }
 
@@ -86,10 +70,10 @@ fn point(rng: &mut Rng) -> Point {
         y: rng.below(1024) as u16,
         octave: rng.below(4) as u8,
         scale: 1,
-        dx: rng.next() as i16,
-        dy: rng.next() as i16,
-        ds: rng.next() as i16,
-        dog: rng.next() as i16,
+        dx: rng.bits() as i16,
+        dy: rng.bits() as i16,
+        ds: rng.bits() as i16,
+        dog: rng.bits() as i16,
     }
 }
 
@@ -116,7 +100,7 @@ fn zero_ending(framer: &mut Framer, numbering: Numbering) -> u32 {
 
 /// The vector file: for each packet its bytes and the link frame `Framer::send` writes.
 fn vectors() -> (String, usize) {
-    let mut rng = Rng(0x5C_F4A3);
+    let mut rng = Rng::new(0x5C_F4A3);
     let mut numbering = Numbering::new(Source::channel(Camera::Right));
     let mut framer = Framer::new();
     let mut text = String::new();
@@ -143,7 +127,7 @@ fn vectors() -> (String, usize) {
         let frame_id = if *kind == 4 {
             zero_ending(&mut framer, numbering)
         } else {
-            rng.next() as u32
+            rng.bits() as u32
         };
         let packet = match kind {
             0 => PacketRepr::SobelRows(SobelRowsRepr {
@@ -166,7 +150,7 @@ fn vectors() -> (String, usize) {
                 width: 640,
                 height: 480,
                 octaves: 4,
-                timestamp_us: if *kind == 4 { 0 } else { rng.next() },
+                timestamp_us: if *kind == 4 { 0 } else { rng.bits() },
             }),
             _ => PacketRepr::FrameEnd(FrameEndRepr {
                 frame_id,
