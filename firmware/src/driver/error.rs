@@ -24,11 +24,12 @@ pub enum DriverError {
         /// Pixels given.
         got: usize,
     },
-    /// The frame is wider than the driver's Sobel ring (`W0`).
+    /// The frame is wider than the fabric's lines (`W0`: its line memories and its stream
+    /// engine's row ring).
     TooWide {
         /// Configured width.
         width: u16,
-        /// The ring's width.
+        /// The fabric's line length.
         max: usize,
     },
     /// The fabric's stream engine stopped the frame at a Sobel pixel outside its octave's
@@ -121,7 +122,7 @@ impl fmt::Display for DriverError {
                 write!(f, "image of {got} pixels, the configured frame has {expected}")
             }
             Self::TooWide { width, max } => {
-                write!(f, "frame width {width} exceeds the driver's Sobel ring ({max})")
+                write!(f, "frame width {width} exceeds the fabric's lines ({max})")
             }
             Self::SobelOutOfOrder(p) => write!(
                 f,

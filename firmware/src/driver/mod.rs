@@ -33,7 +33,10 @@
 //! let image = vec![128u8; 64 * 32];
 //! let summary = driver.process_frame(&image, 0)?;
 //! assert_eq!(summary.frame_id, 0);
-//! // driver.bus().link().0 now holds FrameStart, the frame's packets and FrameEnd, framed.
+//! // The fabric's link holds the frame's link frames: FrameStart, its Sobel packets (a flat
+//! // image has no points) and FrameEnd.
+//! let frames = driver.bus().link().0.iter().filter(|&&b| b == 0).count();
+//! assert_eq!((summary.points, frames as u32), (0, 2 + summary.sobel_packets));
 //! # Ok::<(), stereocal_firmware::driver::DriverError>(())
 //! ```
 //!

@@ -134,11 +134,6 @@ impl<const W0: usize, L: ByteSink> StreamEngine<W0, L> {
         self.out.framer.set_fec(on);
     }
 
-    /// Whether a frame is being sent (between its FRAME_ARM and its end or a soft reset).
-    pub fn is_sending(&self) -> bool {
-        self.out.sending.is_some()
-    }
-
     /// The current (or last) frame's counters.
     pub fn counts(&self) -> StreamCounts {
         self.out.counts
@@ -187,8 +182,8 @@ impl<const W0: usize, L: ByteSink> StreamEngine<W0, L> {
     }
 
     /// Takes every entry the datapath's FIFOs hold, points first, then the Sobel pixels
-    /// octave by octave, and sends what they make ready. With no frame being sent the FIFOs are left to the bus; after a fault the
-    /// frame's entries are taken and discarded.
+    /// octave by octave, and sends what they make ready. With no frame being sent the FIFOs
+    /// are left to the bus; after a fault the frame's entries are taken and discarded.
     pub fn take<F: FrontEnd + ?Sized>(&mut self, datapath: &mut F) {
         if self.out.sending.is_none() {
             return;
