@@ -146,11 +146,6 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
         }
     }
 
-    /// The ring as words, two per pixel.
-    fn ring(&self) -> &[u32] {
-        self.words.as_flattened().as_flattened()
-    }
-
     /// Enqueues one pixel; when full, hands it back.
     pub fn push(&mut self, p: SobelEntry) -> Result<(), SobelEntry> {
         if self.push_run(SobelRun::single(&p)) == 1 {
@@ -200,16 +195,10 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     /// pixels it copied.
     pub fn drain_words(&mut self, max: usize, words: &mut [u32]) -> usize {
         let n = max.min(self.len).min(words.len() / 2);
-        // Up to the end of the ring, then from its start.
-        let first = n.min(Self::CAPACITY - self.head);
-        let ring = self.ring();
-        let parts = (
-            ring.get(2 * self.head..2 * (self.head + first)),
-            ring.get(..2 * (n - first)),
-        );
-        let (Some(tail), Some(start)) = parts else {
-            return 0;
-        };
+        let (first, second) = self.queued();
+        let tail = first.get(..n.min(first.len())).unwrap_or_default();
+        let start = second.get(..n - tail.len()).unwrap_or_default();
+        let (tail, start) = (tail.as_flattened(), start.as_flattened());
         let Some((to_tail, rest)) = words.split_at_mut_checked(tail.len()) else {
             return 0;
         };
@@ -226,34 +215,29 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     /// Hands the oldest `max` queued pixels (all of them, if fewer) to `sink` in runs, oldest
     /// first, and removes them.
     pub fn drain(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        let mut magnitude = [0; DRAIN_RUN];
-        let mut orientation = [0; DRAIN_RUN];
-        // The run being gathered: its first pixel and its length.
-        let mut first = SobelEntry::default();
-        let mut n = 0;
-        for _ in 0..max.min(self.len) {
-            let Some(p) = self.pop() else { break };
-            let continues = n > 0
-                && n < DRAIN_RUN
-                && (p.octave, p.y) == (first.octave, first.y)
-                && usize::from(p.x) == usize::from(first.x) + n;
-            if !continues {
-                if n > 0 {
-                    sink(gathered(&first, n, &magnitude, &orientation));
-                }
-                first = p;
-                n = 0;
-            }
-            if let (Some(m), Some(o)) = (magnitude.get_mut(n), orientation.get_mut(n)) {
-                *m = p.magnitude;
-                *o = p.orientation;
-            }
-            n += 1;
+        let n = max.min(self.len);
+        let (first, second) = self.queued();
+        let mut runs = Runs::new();
+        for &[data, position] in first.iter().chain(second).take(n) {
+            runs.push(data, position, sink);
         }
-        if n > 0 {
-            sink(gathered(&first, n, &magnitude, &orientation));
-        }
+        runs.flush(sink);
+        self.head = Self::wrap(self.head + n);
+        self.len -= n;
     }
+
+    /// The queued pixels' words, oldest first: up to the end of the ring, then from its
+    /// start.
+    fn queued(&self) -> (&[[u32; 2]], &[[u32; 2]]) {
+        let ring = self.words.as_flattened();
+        let (after, before) = ring
+            .split_at_checked(self.head)
+            .map_or((ring, &[][..]), |(b, a)| (a, b));
+        let first = after.get(..self.len.min(after.len())).unwrap_or_default();
+        let second = before.get(..self.len - first.len()).unwrap_or_default();
+        (first, second)
+    }
+
     /// Hands every queued pixel to `sink` in runs, octave 0's first, then octave 1's, 2's
     /// and 3's, each octave's pixels in FIFO order, and empties the FIFO: the order in which
     /// the stream engine stores a line time's pixels (one row ring per octave, so only the
@@ -262,12 +246,7 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     /// pixels aside: with room for every queued pixel, one pass over the FIFO and one per
     /// deeper octave over what was set aside; with less, a pass over the FIFO per octave.
     pub fn drain_by_octave(&mut self, stash: &mut [[u32; 2]], sink: &mut dyn FnMut(SobelRun<'_>)) {
-        let ring = self.words.as_flattened();
-        let (after, before) = ring
-            .split_at_checked(self.head)
-            .map_or((ring, &[][..]), |(b, a)| (a, b));
-        let first = after.get(..self.len.min(after.len())).unwrap_or_default();
-        let second = before.get(..self.len - first.len()).unwrap_or_default();
+        let (first, second) = self.queued();
         let queued = || first.iter().chain(second);
         if stash.len() < self.len {
             // No room to set pixels aside: a pass over the FIFO per octave.
@@ -279,7 +258,7 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
             // deeper octaves' are set aside, in order, for a pass each over what was set
             // aside.
             let mut stashed = 0;
-            let mut runs = OctaveRuns::new(0);
+            let mut runs = Runs::new();
             for &[data, position] in queued() {
                 if sdata::OCTAVE.extract(data) == 0 {
                     runs.push(data, position, sink);
@@ -386,7 +365,7 @@ fn runs_of<'a>(
     words: impl Iterator<Item = &'a [u32; 2]>,
     sink: &mut dyn FnMut(SobelRun<'_>),
 ) {
-    let mut runs = OctaveRuns::new(octave as u8);
+    let mut runs = Runs::new();
     for &[data, position] in words {
         if sdata::OCTAVE.extract(data) == octave {
             runs.push(data, position, sink);
@@ -395,38 +374,40 @@ fn runs_of<'a>(
     runs.flush(sink);
 }
 
-/// The runs of one octave's pixels, gathered from their register words.
-struct OctaveRuns {
-    octave: u8,
+/// Row runs gathered from pixels' register words.
+struct Runs {
     magnitude: [u8; DRAIN_RUN],
     orientation: [u8; DRAIN_RUN],
-    /// The run's first position word and its length.
+    /// The run's data word (its octave), its first position word and its length.
+    data: u32,
     start: u32,
     n: usize,
 }
 
-impl OctaveRuns {
-    fn new(octave: u8) -> Self {
+impl Runs {
+    fn new() -> Self {
         Self {
-            octave,
             magnitude: [0; DRAIN_RUN],
             orientation: [0; DRAIN_RUN],
+            data: 0,
             start: 0,
             n: 0,
         }
     }
 
     /// Adds the pixel of these words, handing the run to `sink` first when the pixel does
-    /// not continue it (another row, a gap, a full buffer). The position word is `y` above
-    /// `x`, so the next column of the row is the next word, unless `x` would wrap.
+    /// not continue it (another octave or row, a gap, a full buffer). The position word is
+    /// `y` above `x`, so the next column of the row is the next word, unless `x` would wrap.
     #[inline]
     fn push(&mut self, data: u32, position: u32, sink: &mut dyn FnMut(SobelRun<'_>)) {
         let continues = self.n > 0
             && self.n < DRAIN_RUN
+            && sdata::OCTAVE.extract(data) == sdata::OCTAVE.extract(self.data)
             && spos::X.extract(self.start) as usize + self.n <= spos::X.bits.max_value() as usize
             && position == self.start.wrapping_add(self.n as u32);
         if !continues {
             self.flush(sink);
+            self.data = data;
             self.start = position;
         }
         if let (Some(m), Some(o)) = (
@@ -445,30 +426,13 @@ impl OctaveRuns {
             return;
         }
         sink(SobelRun {
-            octave: self.octave,
+            octave: sdata::OCTAVE.extract(self.data) as u8,
             y: spos::Y.extract(self.start) as u16,
             x: spos::X.extract(self.start) as u16,
             magnitude: self.magnitude.get(..self.n).unwrap_or_default(),
             orientation: self.orientation.get(..self.n).unwrap_or_default(),
         });
         self.n = 0;
-    }
-}
-
-/// The run of `n` pixels from `first` whose values are the front of `magnitude` and
-/// `orientation`.
-fn gathered<'a>(
-    first: &SobelEntry,
-    n: usize,
-    magnitude: &'a [u8],
-    orientation: &'a [u8],
-) -> SobelRun<'a> {
-    SobelRun {
-        octave: first.octave,
-        y: first.y,
-        x: first.x,
-        magnitude: magnitude.get(..n).unwrap_or_default(),
-        orientation: orientation.get(..n).unwrap_or_default(),
     }
 }
 
