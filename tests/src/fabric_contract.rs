@@ -16,13 +16,14 @@
 use std::collections::VecDeque;
 use std::fmt;
 
+use stereocal::driver::register_writes;
 use stereocal_firmware::fabric::device::{Access, Beat, Clocked};
 use stereocal_firmware::fabric::Config;
 use stereocal_hdl::regs::{
     self, control, output_mode, point_fifo_data, point_fifo_dsdog, point_fifo_dxdy,
     sobel_fifo_data, sobel_fifo_position, status, WINDOW_SIZE,
 };
-use stereocal_hdl::{register_at, FabricConfig, RegisterBank, RegisterBus};
+use stereocal_hdl::{register_at, FabricConfig};
 
 use crate::rng::Rng;
 use crate::rtl_fabric::{W0, W1, W2, W3};
@@ -96,22 +97,7 @@ impl Camera {
         let r = &mut self.rng;
         self.image = match r.below(5) {
             0 => (0..w * h).map(|_| r.bits() as u8).collect(),
-            1..=3 => {
-                let mut img: Vec<u8> = (0..w * h).map(|_| 96 + r.below(32) as u8).collect();
-                for _ in 0..(w * h / 40).max(3) {
-                    let (cx, cy) = (r.below(w as u64) as i64, r.below(h as u64) as i64);
-                    let rad = 1 + r.below(4) as i64;
-                    let v = r.bits() as u8;
-                    for y in (cy - rad).max(0)..(cy + rad + 1).min(h as i64) {
-                        for x in (cx - rad).max(0)..(cx + rad + 1).min(w as i64) {
-                            if (x - cx).pow(2) + (y - cy).pow(2) <= rad * rad {
-                                img[y as usize * w + x as usize] = v;
-                            }
-                        }
-                    }
-                }
-                img
-            }
+            1..=3 => r.blob_image(w, h),
             _ => {
                 let mut img = vec![r.below(256) as u8; w * h];
                 for _ in 0..4 {
@@ -173,25 +159,7 @@ pub fn random_config(r: &mut Rng) -> FabricConfig {
 
 /// The register writes [`FabricConfig::write_to`] makes, in its order.
 pub fn config_writes(config: &FabricConfig) -> Vec<(u16, u32)> {
-    struct Recorder {
-        bank: RegisterBank,
-        writes: Vec<(u16, u32)>,
-    }
-    impl RegisterBus for Recorder {
-        fn read(&mut self, offset: u16) -> u32 {
-            self.bank.read(offset)
-        }
-        fn write(&mut self, offset: u16, value: u32) {
-            self.bank.write(offset, value);
-            self.writes.push((offset, value));
-        }
-    }
-    let mut bus = Recorder {
-        bank: RegisterBank::new(),
-        writes: Vec::new(),
-    };
-    config.write_to(&mut bus).expect("a valid configuration");
-    bus.writes
+    register_writes(|bus| config.write_to(bus)).expect("a valid configuration")
 }
 
 /// Where the schedule's driver is.

@@ -33,4 +33,23 @@ impl Rng {
     pub fn chance(&mut self, per_mille: u64) -> bool {
         self.below(1000) < per_mille
     }
+
+    /// Noise with structure, `w` x `h`: round blobs of random brightness (radius 1 to 4, one
+    /// per 40 pixels) on a background of grey levels 96 to 127.
+    pub fn blob_image(&mut self, w: usize, h: usize) -> Vec<u8> {
+        let mut img: Vec<u8> = (0..w * h).map(|_| 96 + self.below(32) as u8).collect();
+        for _ in 0..(w * h / 40).max(3) {
+            let (cx, cy) = (self.below(w as u64) as i64, self.below(h as u64) as i64);
+            let rad = 1 + self.below(4) as i64;
+            let v = self.bits() as u8;
+            for y in (cy - rad).max(0)..(cy + rad + 1).min(h as i64) {
+                for x in (cx - rad).max(0)..(cx + rad + 1).min(w as i64) {
+                    if (x - cx).pow(2) + (y - cy).pow(2) <= rad * rad {
+                        img[y as usize * w + x as usize] = v;
+                    }
+                }
+            }
+        }
+        img
+    }
 }

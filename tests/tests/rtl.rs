@@ -45,23 +45,9 @@ fn noise(w: usize, h: usize, seed: u64) -> Vec<u8> {
     (0..w * h).map(|_| r.bits() as u8).collect()
 }
 
-/// Noise with structure: blobs of random brightness on a random background.
+/// Noise with structure ([`Rng::blob_image`]) from `seed`.
 fn blobs(w: usize, h: usize, seed: u64) -> Vec<u8> {
-    let mut r = Rng::new(seed);
-    let mut img: Vec<u8> = (0..w * h).map(|_| 96 + (r.bits() % 32) as u8).collect();
-    for _ in 0..(w * h / 40).max(3) {
-        let (cx, cy) = (r.below(w as u64) as i64, r.below(h as u64) as i64);
-        let rad = 1 + r.below(4) as i64;
-        let v = r.bits() as u8;
-        for y in (cy - rad).max(0)..(cy + rad + 1).min(h as i64) {
-            for x in (cx - rad).max(0)..(cx + rad + 1).min(w as i64) {
-                if (x - cx).pow(2) + (y - cy).pow(2) <= rad * rad {
-                    img[y as usize * w + x as usize] = v;
-                }
-            }
-        }
-    }
-    img
+    Rng::new(seed).blob_image(w, h)
 }
 
 fn checkerboard(w: usize, h: usize, cell: usize) -> Vec<u8> {

@@ -42,8 +42,11 @@ impl Recorder {
 }
 
 /// The register writes `op` makes on a bus whose registers are at their reset values, in
-/// order, as the device must receive them.
-pub(crate) fn writes(
+/// order, as the device must receive them: what a program that speaks to a device through
+/// `RegisterWrite` packets (or a test that drives registers itself) sends for a register
+/// operation, e.g. `register_writes(|bus| config.write_to(bus))` (re-exported as
+/// [`crate::driver::register_writes`]).
+pub fn writes(
     op: impl FnOnce(&mut dyn RegisterBus) -> Result<(), Error>,
 ) -> Result<Vec<(u16, u32)>, Error> {
     let mut recorder = Recorder::new();

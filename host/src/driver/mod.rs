@@ -42,6 +42,7 @@ use stereocal_wire::{
 };
 
 pub use assembler::{DamagedFrame, FrameOutcome, LogFrame, ReceivedFrame};
+pub use config::writes as register_writes;
 pub use damage::{ContentError, Damage, DamageCounts, PacketRef};
 pub use error::{DriverError, Waiting};
 pub use keypoint::keypoint;
