@@ -8,7 +8,7 @@
 #define STEREOCAL_WINDOW_SIZE 0x100u
 #define STEREOCAL_REGISTER_WIDTH 32u
 #define STEREOCAL_VERSION_MAJOR 2u
-#define STEREOCAL_VERSION_MINOR 1u
+#define STEREOCAL_VERSION_MINOR 2u
 #define STEREOCAL_MAX_HEIGHT 1024u
 #define STEREOCAL_MAX_OCTAVES 4u
 #define STEREOCAL_MAX_WIDTH 1280u
@@ -18,12 +18,12 @@
 
 /* VERSION (ro): Identifies the fabric and the register-map version it implements. */
 #define STEREOCAL_VERSION_OFFSET 0x00u
-#define STEREOCAL_VERSION_RESET 0x5C010201u
+#define STEREOCAL_VERSION_RESET 0x5C010202u
 /* [7:0] ro: Register-map minor version (additive changes only). */
 #define STEREOCAL_VERSION_MINOR_SHIFT 0u
 #define STEREOCAL_VERSION_MINOR_WIDTH 8u
 #define STEREOCAL_VERSION_MINOR_MASK 0x000000FFu
-#define STEREOCAL_VERSION_MINOR_RESET 0x1u
+#define STEREOCAL_VERSION_MINOR_RESET 0x2u
 /* [15:8] ro: Register-map major version (incompatible changes). */
 #define STEREOCAL_VERSION_MAJOR_SHIFT 8u
 #define STEREOCAL_VERSION_MAJOR_WIDTH 8u
@@ -221,7 +221,7 @@
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_MASK 0xFFFFFFFFu
 #define STEREOCAL_LATENCY_CLOCKS_CLOCKS_RESET 0x0u
 
-/* POINT_FIFO_DATA (ro): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. */
+/* POINT_FIFO_DATA (ro): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. While the stream engine sends a frame (STREAM_CONTROL.ENABLE) the FIFOs are its own: this word reads 0 and pops nothing. */
 #define STEREOCAL_POINT_FIFO_DATA_OFFSET 0x3Cu
 #define STEREOCAL_POINT_FIFO_DATA_RESET 0x00000000u
 /* [10:0] ro: Column in the point's own octave (full-resolution column = X << OCTAVE). */
@@ -278,7 +278,7 @@
 #define STEREOCAL_POINT_FIFO_DSDOG_DOG_MASK 0xFFFF0000u
 #define STEREOCAL_POINT_FIFO_DSDOG_DOG_RESET 0x0u
 
-/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. */
+/* SOBEL_FIFO_DATA (ro): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. While the stream engine sends a frame the FIFOs are its own: this word reads 0 and pops nothing. */
 #define STEREOCAL_SOBEL_FIFO_DATA_OFFSET 0x48u
 #define STEREOCAL_SOBEL_FIFO_DATA_RESET 0x00000000u
 /* [7:0] ro: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs). */
@@ -427,6 +427,11 @@
 #define STEREOCAL_STREAM_FAULT_Y_WIDTH 11u
 #define STEREOCAL_STREAM_FAULT_Y_MASK 0x03FF8000u
 #define STEREOCAL_STREAM_FAULT_Y_RESET 0x0u
+/* [26:26] ro: 1: the engine fell behind the datapath (a snapshot found the snapshot queue full, or a FIFO had no spare slot for the entries the engine still owed), so its packets would no longer be those of the model; the frame stops. The engine's clock is too slow for the pixel rate and the frame's content (docs/STREAM_ENGINE.md, Throughput). */
+#define STEREOCAL_STREAM_FAULT_OVERRUN_SHIFT 26u
+#define STEREOCAL_STREAM_FAULT_OVERRUN_WIDTH 1u
+#define STEREOCAL_STREAM_FAULT_OVERRUN_MASK 0x04000000u
+#define STEREOCAL_STREAM_FAULT_OVERRUN_RESET 0x0u
 
 /* Stream port PIXEL_IN (in): Camera pixels, raster order, at most one per clock. */
 #define STEREOCAL_PORT_PIXEL_IN_DATA_WIDTH 8u

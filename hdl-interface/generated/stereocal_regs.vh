@@ -8,7 +8,7 @@ localparam integer SC_WINDOW_SIZE = 256;
 localparam integer SC_OFFSET_BITS = 8;
 localparam integer SC_REGISTER_WIDTH = 32;
 localparam [7:0] SC_VERSION_MAJOR = 8'd2;
-localparam [7:0] SC_VERSION_MINOR = 8'd1;
+localparam [7:0] SC_VERSION_MINOR = 8'd2;
 localparam integer SC_MAX_HEIGHT = 1024;
 localparam integer SC_MAX_OCTAVES = 4;
 localparam integer SC_MAX_WIDTH = 1280;
@@ -18,13 +18,13 @@ localparam integer SC_SOBEL_FIFO_DEPTH = 3840;
 
 // VERSION (ro): Identifies the fabric and the register-map version it implements.
 localparam [7:0] SC_VERSION_OFFSET = 8'h00;
-localparam [31:0] SC_VERSION_RESET = 32'h5C010201;
+localparam [31:0] SC_VERSION_RESET = 32'h5C010202;
 // [7:0] ro: Register-map minor version (additive changes only).
 localparam integer SC_VERSION_MINOR_LSB = 0;
 localparam integer SC_VERSION_MINOR_MSB = 7;
 localparam integer SC_VERSION_MINOR_WIDTH = 8;
 localparam [31:0] SC_VERSION_MINOR_MASK = 32'h000000FF;
-localparam [7:0] SC_VERSION_MINOR_RESET = 8'h1;
+localparam [7:0] SC_VERSION_MINOR_RESET = 8'h2;
 // [15:8] ro: Register-map major version (incompatible changes).
 localparam integer SC_VERSION_MAJOR_LSB = 8;
 localparam integer SC_VERSION_MAJOR_MSB = 15;
@@ -228,7 +228,7 @@ localparam integer SC_LATENCY_CLOCKS_CLOCKS_WIDTH = 32;
 localparam [31:0] SC_LATENCY_CLOCKS_CLOCKS_MASK = 32'hFFFFFFFF;
 localparam [31:0] SC_LATENCY_CLOCKS_CLOCKS_RESET = 32'h0;
 
-// POINT_FIFO_DATA (ro, read pops): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop.
+// POINT_FIFO_DATA (ro, read pops): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. While the stream engine sends a frame (STREAM_CONTROL.ENABLE) the FIFOs are its own: this word reads 0 and pops nothing.
 localparam [7:0] SC_POINT_FIFO_DATA_OFFSET = 8'h3C;
 localparam [31:0] SC_POINT_FIFO_DATA_RESET = 32'h00000000;
 // [10:0] ro: Column in the point's own octave (full-resolution column = X << OCTAVE).
@@ -294,7 +294,7 @@ localparam integer SC_POINT_FIFO_DSDOG_DOG_WIDTH = 16;
 localparam [31:0] SC_POINT_FIFO_DSDOG_DOG_MASK = 32'hFFFF0000;
 localparam [15:0] SC_POINT_FIFO_DSDOG_DOG_RESET = 16'h0;
 
-// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
+// SOBEL_FIFO_DATA (ro, read pops): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. While the stream engine sends a frame the FIFOs are its own: this word reads 0 and pops nothing.
 localparam [7:0] SC_SOBEL_FIFO_DATA_OFFSET = 8'h48;
 localparam [31:0] SC_SOBEL_FIFO_DATA_RESET = 32'h00000000;
 // [7:0] ro: Gradient magnitude code: CORDIC x after its iterations, scaled and saturated to 8 bits (firmware/src/fabric/cordic.rs).
@@ -461,6 +461,12 @@ localparam integer SC_STREAM_FAULT_Y_MSB = 25;
 localparam integer SC_STREAM_FAULT_Y_WIDTH = 11;
 localparam [31:0] SC_STREAM_FAULT_Y_MASK = 32'h03FF8000;
 localparam [10:0] SC_STREAM_FAULT_Y_RESET = 11'h0;
+// [26:26] ro: 1: the engine fell behind the datapath (a snapshot found the snapshot queue full, or a FIFO had no spare slot for the entries the engine still owed), so its packets would no longer be those of the model; the frame stops. The engine's clock is too slow for the pixel rate and the frame's content (docs/STREAM_ENGINE.md, Throughput).
+localparam integer SC_STREAM_FAULT_OVERRUN_LSB = 26;
+localparam integer SC_STREAM_FAULT_OVERRUN_MSB = 26;
+localparam integer SC_STREAM_FAULT_OVERRUN_WIDTH = 1;
+localparam [31:0] SC_STREAM_FAULT_OVERRUN_MASK = 32'h04000000;
+localparam [0:0] SC_STREAM_FAULT_OVERRUN_RESET = 1'h0;
 
 // Stream port PIXEL_IN (in): Camera pixels, raster order, at most one per clock.
 localparam integer SC_PIXEL_IN_DATA_WIDTH = 8; // in: 8-bit grey level.

@@ -78,10 +78,15 @@ module sc_fabric #(
     input  wire [7:0]  pixel_in_data,
     input  wire        pixel_in_valid,
     output wire        pixel_in_ready,
+    input  wire        pix_ce,           // pixel-clock enable: the datapath advances only now
     input  wire        pixel_in_sof,
     /* verilator lint_off UNUSEDSIGNAL */
-    input  wire        pixel_in_eol      // not checked: lines are counted by WIDTH
+    input  wire        pixel_in_eol,     // not checked: lines are counted by WIDTH
     /* verilator lint_on UNUSEDSIGNAL */
+    // LINK_OUT (AXI4-stream rules): the stream engine's link frames.
+    output wire [7:0]  link_out_data,
+    output wire        link_out_valid,
+    input  wire        link_out_ready
 );
 
     // ---------------------------------------------------------------------------------------
@@ -102,24 +107,23 @@ module sc_fabric #(
     reg  [31:0] latency;
     reg  [31:0] hold_dxdy, hold_dsdog, hold_position;
 
-    // The driver's fields (OUTPUT_MODE.SOBEL_OUTPUT: rows or patches, POINTS_PER_BATCH and
-    // ROW_SEGMENT: how it packs) and the sticky flags' values are not used by the fabric.
-    /* verilator lint_off UNUSEDSIGNAL */
+    // OUTPUT_MODE's packing fields (SOBEL_OUTPUT, POINTS_PER_BATCH, ROW_SEGMENT) are the stream
+    // engine's; the sticky flags' values are not used by the fabric.
     wire        output_mode_sobel_output;
     wire [7:0]  output_mode_points_per_batch;
     wire [10:0] output_mode_row_segment;
-    /* verilator lint_on UNUSEDSIGNAL */
 
-    // The stream engine's registers (docs/STREAM_ENGINE.md). Of its RTL only the framer
-    // (sc_framer.v) is written: the Rust model (firmware/src/fabric/stream) defines the rest,
-    // and this fabric behaves as one whose STREAM_CONTROL.ENABLE is 0 (the FIFOs wait for the
-    // bus; the counters read 0).
-    /* verilator lint_off UNUSEDSIGNAL */
+    // The stream engine's registers (docs/STREAM_ENGINE.md) and its state.
     wire        stream_control_enable, stream_control_fec;
     wire [7:0]  stream_control_camera;
     wire [31:0] frame_id_value, timestamp_lo_value, timestamp_hi_value;
-    /* verilator lint_on UNUSEDSIGNAL */
+    wire [31:0] eng_points, eng_sobel, eng_dropped;
+    wire [1:0]  eng_cause, eng_octave;
+    wire [10:0] eng_fx, eng_fy;
+    wire        eng_overrun;
+    wire        snap_mark;            // the FIFOs' entries become the engine's snapshot
 
+    wire        eng_busy;             // the stream engine sends a frame
     // Point entry: {octave[1:0], dog, ds, dy, dx (16 bits each), y[10:0], x[10:0]} (88 bits);
     // Sobel entry: {octave[1:0], ori[5:0], mag[7:0], y[15:0], x[15:0]} (48 bits).
     wire [87:0] pf_head;
@@ -128,8 +132,10 @@ module sc_fabric #(
     // What the registers show: on SOFT_RESET's clock, the values it clears (shown = 0).
     wire        shown = !soft_reset;
     // What word 0 shows: the head, or all zero when the FIFO is empty.
-    wire        pf_valid = pf_nonempty && shown;
-    wire        sf_valid = sf_nonempty && shown;
+    // While the stream engine sends a frame the FIFOs are its own: their words read 0.
+    wire        bus_owns = !eng_busy;
+    wire        pf_valid = pf_nonempty && shown && bus_owns;
+    wire        sf_valid = sf_nonempty && shown && bus_owns;
     wire [87:0] pf_shown = pf_valid ? pf_head : 88'd0;
     wire [47:0] sf_shown = sf_valid ? sf_head : 48'd0;
     wire [15:0] pf_level16, sf_level16;
@@ -180,10 +186,12 @@ module sc_fabric #(
         .stream_control_camera(stream_control_camera),
         .frame_id_value(frame_id_value), .timestamp_lo_value(timestamp_lo_value),
         .timestamp_hi_value(timestamp_hi_value),
-        .stream_points_count(32'd0), .stream_sobel_packets_count(32'd0),
-        .stream_patches_dropped_count(32'd0),
-        .stream_fault_cause(2'd0), .stream_fault_octave(2'd0), .stream_fault_x(11'd0),
-        .stream_fault_y(11'd0)
+        .stream_points_count(eng_points & {32{shown}}),
+        .stream_sobel_packets_count(eng_sobel & {32{shown}}),
+        .stream_patches_dropped_count(eng_dropped & {32{shown}}),
+        .stream_fault_cause(eng_cause & {2{shown}}), .stream_fault_octave(eng_octave & {2{shown}}),
+        .stream_fault_x(eng_fx & {11{shown}}), .stream_fault_y(eng_fy & {11{shown}}),
+        .stream_fault_overrun(eng_overrun && shown)
     );
 
     /* verilator lint_off UNUSEDSIGNAL */
@@ -192,12 +200,14 @@ module sc_fabric #(
 
     // ---------------------------------------------------------------------------------------
     // Frame control.
-    localparam [1:0] S_IDLE = 2'd0,   // no frame
-                     S_SOF = 2'd1,    // armed: waiting for the SOF pixel
-                     S_RUN = 2'd2,    // taking the frame's pixels
-                     S_FLUSH = 2'd3;  // every pixel in: the octaves drain
+    localparam [2:0] S_IDLE = 3'd0,   // no frame
+                     S_SOF = 3'd1,    // armed: waiting for the SOF pixel
+                     S_RUN = 3'd2,    // taking the frame's pixels
+                     S_FLUSH = 3'd3,  // every pixel in: the octaves drain
+                     S_SEND = 3'd4;   // the octaves are done: the stream engine finishes
 
-    reg  [1:0]  state;
+    reg  [2:0]  state;
+    reg         stream_on;            // the armed frame goes out through the stream engine
     reg  [31:0] total;                // WIDTH x HEIGHT of the armed frame
     reg  [31:0] taken;                // pixels of the frame fed so far
     reg  [1:0]  last_octave;          // OCTAVES - 1 of the armed frame, 0..3
@@ -208,12 +218,13 @@ module sc_fabric #(
     // BUSY from the clock after an accepted FRAME_ARM: a driver that reads STATUS on the next
     // clock sees the arm taken (arm is 0 on SOFT_RESET's clock, and so is busy_shown).
     assign busy_shown = (busy || arm) && shown;
-    assign pixel_in_ready = control_enable && !soft_reset
+    assign pixel_in_ready = control_enable && !soft_reset && pix_ce
                          && (state == S_SOF || state == S_RUN);
     wire take = pixel_in_valid && pixel_in_ready;
     wire feed = take && (state == S_RUN || pixel_in_sof);    // the pixel enters sc_frontend
     wire last_pixel = feed && (taken + 32'd1 == total);
-    assign frame_end = state == S_FLUSH && fe_done && !soft_reset;
+    wire   fe_end = state == S_FLUSH && fe_done && !soft_reset;     // the octaves are done
+    assign frame_end = stream_on ? (state == S_SEND && !eng_busy && !soft_reset) : fe_end;
 
     always @(posedge clk) begin
         if (rst || soft_reset) begin
@@ -229,7 +240,8 @@ module sc_fabric #(
                     state <= last_pixel ? S_FLUSH : S_RUN;
                     taken <= taken + 32'd1;
                 end
-                default: if (fe_done) state <= S_IDLE;
+                S_FLUSH: if (fe_done) state <= stream_on ? S_SEND : S_IDLE;
+                default: if (!eng_busy) state <= S_IDLE;
             endcase
         end
     end
@@ -239,6 +251,11 @@ module sc_fabric #(
             total <= {16'd0, width_value} * {16'd0, height_value};
             last_octave <= octaves_count[1:0] - 2'd1;   // OCTAVES 1..4 -> 0..3
         end
+    end
+
+    always @(posedge clk) begin
+        if (rst || soft_reset) stream_on <= 1'b0;
+        else if (arm) stream_on <= stream_control_enable;
     end
 
     always @(posedge clk) begin
@@ -269,7 +286,7 @@ module sc_fabric #(
     /* verilator lint_on UNUSEDSIGNAL */
 
     sc_frontend #(.W0(W0), .W1(W1), .W2(W2), .W3(W3)) u_frontend (
-        .clk(clk), .start(fe_start),
+        .clk(clk), .start(fe_start), .ce(pix_ce),
         .cfg_width(width_value), .cfg_height(height_value), .cfg_octaves(octaves_count),
         .cfg_contrast(contrast_threshold_value), .cfg_edge_ratio({3'd0, edge_threshold_r}),
         .cfg_sobel_scale(output_mode_sobel_scale), .cfg_max_offset(max_offset_value),
@@ -306,7 +323,7 @@ module sc_fabric #(
                 latency <= lat_now;
                 lat_wait <= 1'b0;
                 lat_run <= 1'b0;
-            end else if (lat_run || feed) begin
+            end else if (pix_ce && (lat_run || feed)) begin
                 lat_run <= 1'b1;
                 lat_count <= lat_now + 32'd1;
             end
@@ -336,18 +353,24 @@ module sc_fabric #(
 
     // ---------------------------------------------------------------------------------------
     // The two FIFOs (sc_out_fifo: up to 4 entries per clock in octave order, one pop).
-    sc_out_fifo #(.DW(88), .DEPTH(POINT_DEPTH)) u_point_fifo (
+    // ... and a bus read of their heads pops nothing and loads no holding register.
+    wire        pf_bus_pop = point_fifo_data_pop && bus_owns;
+    wire        sf_bus_pop = sobel_fifo_data_pop && bus_owns;
+    wire        eng_pf_pop, eng_sf_pop;
+    wire        pf_overrun, sf_overrun;
+
+    sc_out_fifo #(.DW(88), .DEPTH(POINT_DEPTH), .SPARE(POINT_DEPTH)) u_point_fifo (
         .clk(clk), .clear(rst || soft_reset),
-        .in_valid(pf_v), .in_data(pf_in), .pop(point_fifo_data_pop),
+        .in_valid(pf_v), .in_data(pf_in), .pop(pf_bus_pop || eng_pf_pop), .mark(snap_mark),
         .head(pf_head), .nonempty(pf_nonempty), .level(pf_level16),
-        .dropped(pf_dropped32), .dropping(pf_dropping)
+        .dropped(pf_dropped32), .dropping(pf_dropping), .overrun(pf_overrun)
     );
 
-    sc_out_fifo #(.DW(48), .DEPTH(SOBEL_DEPTH)) u_sobel_fifo (
+    sc_out_fifo #(.DW(48), .DEPTH(SOBEL_DEPTH), .SPARE(SOBEL_DEPTH)) u_sobel_fifo (
         .clk(clk), .clear(rst || soft_reset),
-        .in_valid(sf_v), .in_data(sf_in), .pop(sobel_fifo_data_pop),
+        .in_valid(sf_v), .in_data(sf_in), .pop(sf_bus_pop || eng_sf_pop), .mark(snap_mark),
         .head(sf_head), .nonempty(sf_nonempty), .level(sf_level16),
-        .dropped(sf_dropped32), .dropping(sf_dropping)
+        .dropped(sf_dropped32), .dropping(sf_dropping), .overrun(sf_overrun)
     );
 
     // Holding registers: loaded by the read that pops word 0 (zero when the FIFO was empty).
@@ -357,14 +380,61 @@ module sc_fabric #(
             hold_dsdog <= 32'd0;
             hold_position <= 32'd0;
         end else begin
-            if (point_fifo_data_pop) begin
+            if (pf_bus_pop) begin
                 hold_dxdy <= pf_shown[53:22];     // {dy, dx}
                 hold_dsdog <= pf_shown[85:54];    // {dog, ds}
             end
-            if (sobel_fifo_data_pop)
+            if (sf_bus_pop)
                 hold_position <= sf_shown[31:0];  // {y, x}
         end
     end
+
+    // ---------------------------------------------------------------------------------------
+    // Line times and snapshots. A line time ends on the clock that feeds a line's last pixel
+    // and every WIDTH pixel clocks of the flush after the last line (the model's
+    // FabricDevice::clock); on the clock after it the FIFOs are marked, and their entries
+    // (everything held after that edge, `level`) are the engine's snapshot. The octaves'
+    // end marks the last one.
+    reg  [15:0] col;                  // column of the next pixel fed
+    reg  [15:0] blank;                // flush pixel clocks since the last line time
+    reg         line_d;               // the previous clock ended a line time
+    wire        line_fed = feed && (col + 16'd1 == width_value);
+    wire        line_blank = state == S_FLUSH && !fe_done && pix_ce
+                          && (blank + 16'd1 == width_value);
+    wire        snap_final = stream_on && fe_end;
+    assign      snap_mark = stream_on && (line_d || snap_final);
+    always @(posedge clk) begin
+        if (rst || soft_reset || arm) begin
+            col <= 16'd0;
+            blank <= 16'd0;
+            line_d <= 1'b0;
+        end else begin
+            if (feed) col <= line_fed ? 16'd0 : col + 16'd1;
+            if (state == S_FLUSH && !fe_done && pix_ce) blank <= line_blank ? 16'd0 : blank + 16'd1;
+            line_d <= line_fed || line_blank;
+        end
+    end
+
+    sc_stream #(.W0(W0), .STASH(SOBEL_DEPTH)) u_stream (
+        .clk(clk), .abort(rst || soft_reset), .rst(rst),
+        .arm(arm && stream_control_enable),
+        .cfg_width(width_value), .cfg_height(height_value), .cfg_octaves(octaves_count),
+        .cfg_patches(output_mode_sobel_output), .cfg_scale(output_mode_sobel_scale),
+        .cfg_batch(output_mode_points_per_batch), .cfg_segment(output_mode_row_segment),
+        .cfg_frame_id(frame_id_value), .cfg_camera(stream_control_camera),
+        .cfg_timestamp({timestamp_hi_value, timestamp_lo_value}), .fec(stream_control_fec),
+        .drops_points(pf_dropped32), .drops_sobel(sf_dropped32),
+        .fifo_overrun(pf_overrun || sf_overrun),
+        .snap_valid(snap_mark), .snap_points(pf_level16), .snap_sobel(sf_level16),
+        .snap_final(snap_final),
+        .pf_head(pf_head), .pf_nonempty(pf_nonempty), .pf_pop(eng_pf_pop),
+        .sf_head(sf_head), .sf_nonempty(sf_nonempty), .sf_pop(eng_sf_pop),
+        .busy(eng_busy),
+        .count_points(eng_points), .count_sobel(eng_sobel), .count_dropped(eng_dropped),
+        .fault_cause(eng_cause), .fault_octave(eng_octave), .fault_x(eng_fx), .fault_y(eng_fy),
+        .fault_overrun(eng_overrun),
+        .link_data(link_out_data), .link_valid(link_out_valid), .link_ready(link_out_ready)
+    );
 
 endmodule
 

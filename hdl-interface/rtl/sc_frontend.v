@@ -24,6 +24,7 @@ module sc_frontend #(
 ) (
     input  wire         clk,
     input  wire         start,
+    input  wire         ce,              // pixel-clock enable (sc_octave): advance only now
     input  wire [15:0]  cfg_width,
     input  wire [15:0]  cfg_height,
     input  wire [2:0]   cfg_octaves,     // 1..4
@@ -87,7 +88,7 @@ module sc_frontend #(
                 .dim_w(dim_w[k*16 +: 16]), .dim_h(dim_h[k*16 +: 16]),
                 .cfg_contrast(contrast), .cfg_edge_ratio(edge_ratio),
                 .cfg_sobel_scale(sobel_scale), .cfg_max_offset(max_offset),
-                .active(octaves > k),
+                .active(octaves > k), .ce(ce),
                 .in_valid(in_valid[k]), .in_data(in_data[k*16 +: 16]),
                 .en(oct_en[k]), .done(oct_done[k]),
                 .g_valid(g_valid[k*4 +: 4]), .g_data(g_data[k*64 +: 64]),

@@ -8,7 +8,10 @@
 // (sc_sobel) and sc_cordic, and the subsampler feeding the next octave.
 //
 // Clocking (rtl_spec.md): all stages share `en = in_valid || flushing` with
-// `flushing = taken == total && !done` (only while `active`, never on `start`). Every stage
+// `flushing = taken == total && !done` (only while `active` and `ce`, never on `start`).
+// `ce` is the pixel-clock enable of a fabric whose clock runs faster than its camera
+// (sc_fabric's pix_ce): with `ce` low nothing advances, so the outputs are the same sequence
+// whatever the ratio. Every stage
 // sees its upstream stage's output register of the same clock; the outputs (g, DoG, point,
 // Sobel pixel, subsampled sample) are the output registers before the edge, valid only while
 // `en` is high. `done` is octave.rs `done()`.
@@ -36,6 +39,7 @@ module sc_octave #(
     input  wire [1:0]   cfg_sobel_scale,  // likewise
     input  wire [15:0]  cfg_max_offset,   // raw Q2.13, likewise
     input  wire         active,           // the octave is configured (k < cfg_octaves)
+    input  wire         ce,               // pixel-clock enable: the octave may advance only now
     input  wire         in_valid,         // an input sample this clock
     input  wire [15:0]  in_data,          // u16 Q8.8
     output wire         en,               // the octave advances on this clock
@@ -67,7 +71,7 @@ module sc_octave #(
     reg [31:0] taken;  // input samples taken, <= total
 
     wire flushing = taken == total && !done;
-    assign en = !start && active && (in_valid || flushing);
+    assign en = ce && !start && active && (in_valid || flushing);
 
     always @(posedge clk) begin
         if (start) begin

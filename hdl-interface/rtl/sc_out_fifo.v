@@ -21,36 +21,51 @@
 // through. `head` is meaningful only while `nonempty`. The memories are never reset: `clear`
 // (synchronous) empties the FIFO and zeroes `dropped`.
 //
-// DEPTH: a multiple of 4, at most 65535 (`level` is 16 bits).
+// Snapshots (the stream engine, docs/STREAM_ENGINE.md): `mark` hands every entry held before
+// the edge to the engine (`owed`; the engine pops them, one per pop). DEPTH then bounds the
+// entries not owed, so the drops equal those of the model, whose engine takes the FIFO whole
+// at each line time; the owed entries use SPARE more slots. An item refused only for want of
+// a spare slot is counted as a drop and flagged on `overrun` (the engine fell behind: it did
+// not pop a snapshot's entries before the next ones needed their room). Without marks
+// (`owed` 0) the FIFO is the plain one of DEPTH entries.
+//
+// DEPTH + SPARE: a multiple of 4, at most 65535 (`level` is 16 bits).
 `default_nettype none
 
 module sc_out_fifo #(
     parameter DW = 88,                   // entry width
-    parameter DEPTH = 512                // entries; a multiple of 4, <= 65535
+    parameter DEPTH = 512,               // entries not owed to the engine
+    parameter SPARE = 0                  // more slots for owed entries
 ) (
     input  wire          clk,
     input  wire          clear,          // synchronous: empties the FIFO, zeroes `dropped`
     input  wire [3:0]    in_valid,       // item k (octave k) arrives on this clock
     input  wire [4*DW-1:0] in_data,      // item k at [k*DW +: DW]
     input  wire          pop,            // remove the head (ignored when empty)
+    input  wire          mark,           // every entry held before the edge becomes owed
     output wire [DW-1:0] head,           // the oldest entry (valid while nonempty)
     output wire          nonempty,
-    output wire [15:0]   level,          // entries held, 0..DEPTH
+    output wire [15:0]   level,          // entries held and not owed, 0..DEPTH
     output wire [31:0]   dropped,        // items not kept since `clear`, saturating
-    output wire          dropping        // an item is not kept on this clock
+    output wire          dropping,       // an item is not kept on this clock
+    output wire          overrun         // ... for want of a spare slot
 );
 
-    localparam ROWS = DEPTH / 4;
+    localparam PHYS = DEPTH + SPARE;
+    localparam ROWS = PHYS / 4;
     localparam AW   = (ROWS > 1) ? $clog2(ROWS) : 1;    // row address bits
-    localparam LW   = $clog2(DEPTH + 1);                 // level: 0..DEPTH
+    localparam LW   = $clog2(PHYS + 1);                  // count: 0..PHYS
     localparam integer  FULL_I = DEPTH;
     localparam [LW-1:0] FULL = FULL_I[LW-1:0];
+    localparam integer  PFULL_I = PHYS;
+    localparam [LW-1:0] PFULL = PFULL_I[LW-1:0];
     localparam integer  LAST_I = ROWS - 1;
     localparam [AW-1:0] LAST = LAST_I[AW-1:0];
 
     reg  [AW-1:0] wrow, rrow;
     reg  [1:0]    wlane, rlane;
-    reg  [LW-1:0] count;
+    reg  [LW-1:0] count;            // entries held
+    reg  [LW-1:0] owed;             // of them, owed to the engine
     reg  [31:0]   drops;            // saturating overflow count
 
     // Ranks within the clock, 0..3, and the slot lane each item would take.
@@ -59,8 +74,11 @@ module sc_out_fifo #(
     wire [2:0]  r3 = r2 + {2'd0, in_valid[2]};
     wire [2:0]  n  = r3 + {2'd0, in_valid[3]};           // arrivals, 0..4
     wire [11:0] rank = {r3, r2, r1, 3'd0};               // item k at [k*3 +: 3]
-    wire [LW-1:0] free = FULL - count;
-    wire [2:0]  acc = ({{(LW-3){1'b0}}, n} <= free) ? n : free[2:0];
+    wire [LW-1:0] free_l = FULL - (count - owed);
+    wire [LW-1:0] free_p = PFULL - count;
+    wire [LW-1:0] free = (free_p < free_l) ? free_p : free_l;
+    wire [LW-1:0] n_w = {{(LW-3){1'b0}}, n};
+    wire [2:0]  acc = (n_w <= free) ? n : free[2:0];
     wire [2:0]  drop = n - acc;                          // 0..4
     wire [3:0]  take;                                    // item k is kept
     wire [15:0] hit;                                     // [k*4 + b]: item k -> bank b
@@ -113,8 +131,13 @@ module sc_out_fifo #(
             wlane <= 2'd0;
             rlane <= 2'd0;
             count <= {LW{1'b0}};
+            owed <= {LW{1'b0}};
             drops <= 32'd0;
         end else begin
+            if (mark)
+                owed <= count - {{(LW-1){1'b0}}, popped};
+            else if (owed != {LW{1'b0}})
+                owed <= owed - {{(LW-1){1'b0}}, popped};
             wlane <= lane_sum[1:0];
             if (lane_sum[2]) wrow <= wrow_next;
             rlane <= rlane_n;
@@ -128,9 +151,11 @@ module sc_out_fifo #(
     end
 
     assign nonempty = count != {LW{1'b0}};
-    assign level = {{(16 - LW){1'b0}}, count};
+    wire [LW-1:0] held = count - owed;
+    assign level = {{(16 - LW){1'b0}}, held};
     assign dropped = drops;
     assign dropping = drop != 3'd0;
+    assign overrun = (n_w > free_p) && (free_p < free_l);
 
 endmodule
 

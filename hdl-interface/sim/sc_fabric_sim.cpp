@@ -36,6 +36,8 @@ sc_fabric_sim *sc_fabric_sim_new(uint32_t rand_seed) {
     t->pixel_in_valid = 0;
     t->pixel_in_sof = 0;
     t->pixel_in_eol = 0;
+    t->pix_ce = 1;
+    t->link_out_ready = 0;
     t->eval();
     return s;
 }
@@ -59,8 +61,12 @@ void sc_fabric_sim_clock(sc_fabric_sim *s, const sc_fabric_in *in, sc_fabric_out
     t->pixel_in_data = in->pixel_data;
     t->pixel_in_sof = in->pixel_sof ? 1 : 0;
     t->pixel_in_eol = in->pixel_eol ? 1 : 0;
+    t->pix_ce = in->pix_ce ? 1 : 0;
+    t->link_out_ready = in->link_ready ? 1 : 0;
     t->eval();
     out->pixel_ready = t->pixel_in_ready ? 1 : 0;
+    out->link_valid = t->link_out_valid ? 1 : 0;
+    out->link_data = t->link_out_data;
 
     t->clk = 1;
     t->eval();

@@ -28,13 +28,17 @@ typedef struct {
     uint8_t pixel_sof;
     uint8_t pixel_eol;
     uint8_t rst;             /* synchronous reset, active high */
+    uint8_t pix_ce;          /* pixel-clock enable: the datapath advances on this clock */
+    uint8_t link_ready;      /* LINK_OUT's TREADY */
 } sc_fabric_in;
 
 /* What one clock shows. */
 typedef struct {
     uint32_t bus_rdata;      /* AFTER the rising edge: the word a read on this clock returns */
     uint8_t pixel_ready;     /* pixel_in_ready BEFORE the edge, with the inputs applied */
-    uint8_t _pad[3];
+    uint8_t link_valid;      /* LINK_OUT's TVALID BEFORE the edge: with link_ready, */
+    uint8_t link_data;       /* this byte left on the clock */
+    uint8_t _pad;
 } sc_fabric_out;
 
 typedef struct sc_fabric_sim sc_fabric_sim;

@@ -68,6 +68,7 @@ sc_sim *sc_sim_new(uint32_t rand_seed) {
     s->top->clk = 0;
     s->top->start = 0;
     s->top->pix_valid = 0;
+    s->top->ce = 1;
     s->top->pix_data = 0;
     s->top->eval();
     return s;

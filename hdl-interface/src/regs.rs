@@ -14,7 +14,7 @@ pub const WINDOW_SIZE: u32 = 0x100;
 pub const REGISTER_WIDTH: u32 = 32;
 /// Register-map version this crate was generated for (VERSION.MAJOR / VERSION.MINOR).
 pub const VERSION_MAJOR: u32 = 2;
-pub const VERSION_MINOR: u32 = 1;
+pub const VERSION_MINOR: u32 = 2;
 /// Synthesis parameter `max_height` of the description.
 pub const MAX_HEIGHT: u32 = 1024;
 /// Synthesis parameter `max_octaves` of the description.
@@ -35,7 +35,7 @@ pub mod version {
     /// Byte offset from [`super::BASE_ADDRESS`].
     pub const OFFSET: u16 = 0x00;
     /// Value after reset.
-    pub const RESET: u32 = 0x5C01_0201;
+    pub const RESET: u32 = 0x5C01_0202;
     /// Offset, reset and access masks.
     pub const REGISTER: Register = Register {
         name: "VERSION",
@@ -48,13 +48,13 @@ pub mod version {
         pops_on_read: false,
     };
 
-    /// `[7:0]` ro, reset 1: Register-map minor version (additive changes only).
+    /// `[7:0]` ro, reset 2: Register-map minor version (additive changes only).
     pub const MINOR: Field = Field {
         name: "VERSION.MINOR",
         offset: OFFSET,
         bits: BitRange { lsb: 0, width: 8 },
         access: Access::Ro,
-        reset: 1,
+        reset: 2,
         min: 0,
         max: 255,
     };
@@ -647,7 +647,7 @@ pub mod latency_clocks {
     };
 }
 
-/// Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. Offset 0x3C, ro.
+/// Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. While the stream engine sends a frame (STREAM_CONTROL.ENABLE) the FIFOs are its own: this word reads 0 and pops nothing. Offset 0x3C, ro.
 pub mod point_fifo_data {
     use crate::{Access, BitRange, Field, Register};
 
@@ -809,7 +809,7 @@ pub mod point_fifo_dsdog {
     };
 }
 
-/// Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. Offset 0x48, ro.
+/// Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. While the stream engine sends a frame the FIFOs are its own: this word reads 0 and pops nothing. Offset 0x48, ro.
 pub mod sobel_fifo_data {
     use crate::{Access, BitRange, Field, Register};
 
@@ -1208,7 +1208,7 @@ pub mod stream_fault {
         name: "STREAM_FAULT",
         offset: OFFSET,
         reset: RESET,
-        ro_mask: 0x03FF_FFFF,
+        ro_mask: 0x07FF_FFFF,
         rw_mask: 0x0000_0000,
         w1c_mask: 0x0000_0000,
         wo_mask: 0x0000_0000,
@@ -1292,6 +1292,17 @@ pub mod stream_fault {
         reset: 0,
         min: 0,
         max: 2047,
+    };
+
+    /// `[26:26]` ro, reset 0: 1: the engine fell behind the datapath (a snapshot found the snapshot queue full, or a FIFO had no spare slot for the entries the engine still owed), so its packets would no longer be those of the model; the frame stops. The engine's clock is too slow for the pixel rate and the frame's content (docs/STREAM_ENGINE.md, Throughput).
+    pub const OVERRUN: Field = Field {
+        name: "STREAM_FAULT.OVERRUN",
+        offset: OFFSET,
+        bits: BitRange { lsb: 26, width: 1 },
+        access: Access::Ro,
+        reset: 0,
+        min: 0,
+        max: 1,
     };
 }
 

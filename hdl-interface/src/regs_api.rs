@@ -28,7 +28,7 @@ use crate::{regs, Error, RegisterBus};
 pub trait Registers: RegisterBus {
     // VERSION (offset 0x00): Identifies the fabric and the register-map version it implements.
 
-    /// VERSION.MINOR `[7:0]` ro, reset 1: Register-map minor version (additive changes only).
+    /// VERSION.MINOR `[7:0]` ro, reset 2: Register-map minor version (additive changes only).
     fn version_minor(&mut self) -> u8 {
         self.read_field(&regs::version::MINOR) as u8
     }
@@ -249,7 +249,7 @@ pub trait Registers: RegisterBus {
         self.read_field(&regs::latency_clocks::CLOCKS)
     }
 
-    // POINT_FIFO_DATA (offset 0x3C): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop.
+    // POINT_FIFO_DATA (offset 0x3C): Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. While the stream engine sends a frame (STREAM_CONTROL.ENABLE) the FIFOs are its own: this word reads 0 and pops nothing.
 
     /// Reads POINT_FIFO_DATA once (the read pops the FIFO's head) and returns the whole word.
     fn pop_point_fifo_data(&mut self) -> PointFifoData {
@@ -280,7 +280,7 @@ pub trait Registers: RegisterBus {
         self.read_field(&regs::point_fifo_dsdog::DOG) as u16
     }
 
-    // SOBEL_FIFO_DATA (offset 0x48): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
+    // SOBEL_FIFO_DATA (offset 0x48): Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. While the stream engine sends a frame the FIFOs are its own: this word reads 0 and pops nothing.
 
     /// Reads SOBEL_FIFO_DATA once (the read pops the FIFO's head) and returns the whole word.
     fn pop_sobel_fifo_data(&mut self) -> SobelFifoData {
@@ -426,11 +426,16 @@ pub trait Registers: RegisterBus {
     fn stream_fault_y(&mut self) -> u16 {
         self.read_field(&regs::stream_fault::Y) as u16
     }
+
+    /// STREAM_FAULT.OVERRUN `[26:26]` ro, reset 0: 1: the engine fell behind the datapath (a snapshot found the snapshot queue full, or a FIFO had no spare slot for the entries the engine still owed), so its packets would no longer be those of the model; the frame stops. The engine's clock is too slow for the pixel rate and the frame's content (docs/STREAM_ENGINE.md, Throughput).
+    fn stream_fault_overrun(&mut self) -> bool {
+        self.read_field(&regs::stream_fault::OVERRUN) != 0
+    }
 }
 
 impl<B: RegisterBus + ?Sized> Registers for B {}
 
-/// A value of POINT_FIFO_DATA, as [`Registers::pop_point_fifo_data`] read it: Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop.
+/// A value of POINT_FIFO_DATA, as [`Registers::pop_point_fifo_data`] read it: Head of the point FIFO, word 0 of 3 (Extremum of the model: x, y, octave, scale here; dx, dy in POINT_FIFO_DXDY; ds, dog in POINT_FIFO_DSDOG). The read that pops also loads the point's other two words into holding registers: read this word first, then POINT_FIFO_DXDY and POINT_FIFO_DSDOG (in any order, as often as wanted) before the next pop. While the stream engine sends a frame (STREAM_CONTROL.ENABLE) the FIFOs are its own: this word reads 0 and pops nothing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PointFifoData(pub u32);
 
@@ -461,7 +466,7 @@ impl PointFifoData {
     }
 }
 
-/// A value of SOBEL_FIFO_DATA, as [`Registers::pop_sobel_fifo_data`] read it: Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first.
+/// A value of SOBEL_FIFO_DATA, as [`Registers::pop_sobel_fifo_data`] read it: Head of the Sobel FIFO, word 0 of 2 (SobelEntry of the model: octave, orientation, magnitude here; x, y in SOBEL_FIFO_POSITION). The read that pops also loads the pixel's position into SOBEL_FIFO_POSITION: read this word first. While the stream engine sends a frame the FIFOs are its own: this word reads 0 and pops nothing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SobelFifoData(pub u32);
 

@@ -28,6 +28,7 @@ pub mod fabric_contract;
 pub mod rng;
 pub mod rtl;
 pub mod rtl_fabric;
+pub mod stream_cosim;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

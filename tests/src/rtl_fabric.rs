@@ -58,6 +58,8 @@ mod ffi {
         pub pixel_sof: u8,
         pub pixel_eol: u8,
         pub rst: u8,
+        pub pix_ce: u8,
+        pub link_ready: u8,
     }
 
     #[repr(C)]
@@ -65,7 +67,9 @@ mod ffi {
     pub struct Out {
         pub bus_rdata: u32,
         pub pixel_ready: u8,
-        pub pad: [u8; 3],
+        pub link_valid: u8,
+        pub link_data: u8,
+        pub pad: u8,
     }
 
     #[repr(C)]
@@ -143,9 +147,13 @@ impl RtlFabric {
         let mut rtl = Self { sim };
         rtl.step(&ffi::In {
             rst: 1,
+            pix_ce: 1,
             ..ffi::In::default()
         });
-        rtl.step(&ffi::In::default());
+        rtl.step(&ffi::In {
+            pix_ce: 1,
+            ..ffi::In::default()
+        });
         rtl
     }
 
@@ -156,9 +164,22 @@ impl RtlFabric {
         out
     }
 
-    /// One clock with `pixel` on PIXEL_IN and `access` on the bus; what it shows, as
-    /// [`FabricDevice::clock`] returns it.
+    /// One clock with `pixel` on PIXEL_IN and `access` on the bus, every clock a pixel clock;
+    /// what it shows, as [`FabricDevice::clock`] returns it.
     pub fn clock(&mut self, pixel: Option<Beat>, access: Option<Access>) -> Clocked {
+        self.clock_linked(pixel, access, true, true).0
+    }
+
+    /// One clock with `pixel` on PIXEL_IN, `access` on the bus, `pix_ce` (whether this clock
+    /// is a pixel clock) and LINK_OUT's ready; what it shows, and the byte LINK_OUT sent on
+    /// it.
+    pub fn clock_linked(
+        &mut self,
+        pixel: Option<Beat>,
+        access: Option<Access>,
+        pix_ce: bool,
+        link_ready: bool,
+    ) -> (Clocked, Option<u8>) {
         let beat = pixel.unwrap_or_default();
         let (bus_addr, bus_wdata, bus_we, bus_re) = match access {
             // The bus carries 8 address bits: offsets beyond the window alias into it, so
@@ -177,10 +198,16 @@ impl RtlFabric {
             pixel_sof: beat.sof as u8,
             pixel_eol: beat.eol as u8,
             rst: 0,
+            pix_ce: pix_ce as u8,
+            link_ready: link_ready as u8,
         });
-        Clocked {
-            ready: out.pixel_ready != 0,
-            read: (bus_re != 0).then_some(out.bus_rdata),
-        }
+        let sent = (out.link_valid != 0 && link_ready).then_some(out.link_data);
+        (
+            Clocked {
+                ready: out.pixel_ready != 0,
+                read: (bus_re != 0).then_some(out.bus_rdata),
+            },
+            sent,
+        )
     }
 }

@@ -467,6 +467,9 @@ impl<F: FrontEnd, const W0: usize, L: ByteSink> FabricDevice<F, W0, L> {
             sobel_overflow_count::OFFSET => self.datapath.overflow().sobel,
             frame_count::OFFSET => self.frame_count,
             latency_clocks::OFFSET => self.latency,
+            // While the stream engine sends a frame the FIFOs are its own: their words read 0
+            // and pop nothing.
+            point_fifo_data::OFFSET | sobel_fifo_data::OFFSET if self.stream.sending() => 0,
             point_fifo_data::OFFSET => return Sample::PopPoint,
             point_fifo_dxdy::OFFSET => self.point_hold[0],
             point_fifo_dsdog::OFFSET => self.point_hold[1],

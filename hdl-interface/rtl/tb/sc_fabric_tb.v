@@ -44,7 +44,8 @@ module sc_fabric_tb;
         .bus_rdata(bus_rdata),
         .pixel_in_data(pixel_in_data), .pixel_in_valid(pixel_in_valid),
         .pixel_in_ready(pixel_in_ready), .pixel_in_sof(pixel_in_sof),
-        .pixel_in_eol(pixel_in_eol)
+        .pixel_in_eol(pixel_in_eol), .pix_ce(1'b1),
+        .link_out_data(), .link_out_valid(), .link_out_ready(1'b1)
     );
 
     always #5 clk = ~clk;
@@ -318,7 +319,7 @@ module sc_fabric_tb;
         repeat (3) @(negedge clk);
         rst = 1'b0;
         read(8'h00, v);
-        check("VERSION", v, 32'h5C01_0201);
+        check("VERSION", v, 32'h5C01_0202);
         write(8'h0C, W);
         write(8'h10, H);
         write(8'h14, OCTAVES);

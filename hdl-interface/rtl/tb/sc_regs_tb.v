@@ -43,6 +43,7 @@ module sc_regs_tb;
     reg  [31:0] stream_points = 32'h0, stream_sobel_packets = 32'h0, stream_patches_dropped = 32'h0;
     reg  [1:0]  fault_cause = 2'h0, fault_octave = 2'h0;
     reg  [10:0] fault_x = 11'h0, fault_y = 11'h0;
+    reg         fault_overrun = 1'b0;
 
     sc_regs dut (
         .clk(clk), .rst(rst), .flags_clear(flags_clear),
@@ -84,7 +85,8 @@ module sc_regs_tb;
         .stream_points_count(stream_points), .stream_sobel_packets_count(stream_sobel_packets),
         .stream_patches_dropped_count(stream_patches_dropped),
         .stream_fault_cause(fault_cause), .stream_fault_octave(fault_octave),
-        .stream_fault_x(fault_x), .stream_fault_y(fault_y)
+        .stream_fault_x(fault_x), .stream_fault_y(fault_y),
+        .stream_fault_overrun(fault_overrun)
     );
 
     always #5 clk = ~clk;
@@ -126,7 +128,7 @@ module sc_regs_tb;
         rst = 1'b0;
 
         // Resets and constants.
-        expect_read("VERSION", 8'h00, 32'h5C01_0201);
+        expect_read("VERSION", 8'h00, 32'h5C01_0202);
         expect_read("CONTROL reset", 8'h04, 32'h0);
         expect_read("STATUS reset", 8'h08, 32'h0);
         expect_read("WIDTH reset", 8'h0C, 32'd640);
@@ -168,7 +170,7 @@ module sc_regs_tb;
 
         // ro: bus writes ignored, the fabric's value read.
         write(8'h00, 32'h0);
-        expect_read("VERSION after write", 8'h00, 32'h5C01_0201);
+        expect_read("VERSION after write", 8'h00, 32'h5C01_0202);
         point_level = 16'd512; sobel_level = 16'd3840;
         point_overflows = 32'hFFFF_FFFF; sobel_overflows = 32'd7; frames = 32'd3;
         latency = 32'd1234; dx = 16'hF000; dy = 16'h0800; ds = 16'hFFFF; dog = 16'hFC80;
@@ -185,10 +187,11 @@ module sc_regs_tb;
         expect_read("SOBEL_FIFO_POSITION", 8'h4C, 32'h00EF_013F);
         stream_points = 32'd1000; stream_sobel_packets = 32'd77; stream_patches_dropped = 32'd5;
         fault_cause = 2'd1; fault_octave = 2'd3; fault_x = 11'd1279; fault_y = 11'd1023;
+        fault_overrun = 1'b1;
         expect_read("STREAM_POINTS", 8'h64, 32'd1000);
         expect_read("STREAM_SOBEL_PACKETS", 8'h68, 32'd77);
         expect_read("STREAM_PATCHES_DROPPED", 8'h6C, 32'd5);
-        expect_read("STREAM_FAULT", 8'h70, {6'h0, 11'd1023, 11'd1279, 2'd3, 2'd1});
+        expect_read("STREAM_FAULT", 8'h70, {5'h0, 1'b1, 11'd1023, 11'd1279, 2'd3, 2'd1});
 
         // w1c: set by the fabric, cleared by writing 1, a set beats a clear on one clock.
         status_busy = 1'b1;

@@ -134,6 +134,11 @@ impl<const W0: usize, L: ByteSink> StreamEngine<W0, L> {
         self.out.framer.set_fec(on);
     }
 
+    /// Whether a frame is being sent (FRAME_ARM up to its end): the FIFOs are the engine's.
+    pub fn sending(&self) -> bool {
+        self.out.sending.is_some()
+    }
+
     /// The current (or last) frame's counters.
     pub fn counts(&self) -> StreamCounts {
         self.out.counts
