@@ -257,6 +257,56 @@ pub fn qemu_or_skip(test: &str) -> Option<QemuConfig> {
     firmware_elf_or_skip(test).map(QemuConfig::new)
 }
 
+/// The firmware ELF on the SoC in the loop ([`QemuConfig::soc`]): the simulator built once
+/// per test binary by `hdl-interface/soc/build.sh` into `target/soc` (it fetches the core
+/// from PyPI into a venv there and verilates it), or `None` after a loud `SKIPPED` line when
+/// a tool it needs is missing or the build fails (a failure under `CI=true`).
+pub fn soc_or_skip(test: &str) -> Option<QemuConfig> {
+    static SIM: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let sim = match SIM.get_or_init(build_soc) {
+        Ok(sim) => sim.clone(),
+        Err(reason) => {
+            skip(test, reason);
+            return None;
+        }
+    };
+    firmware_elf_or_skip(test).map(|elf| QemuConfig {
+        soc: Some(sim),
+        ..QemuConfig::new(elf)
+    })
+}
+
+fn build_soc() -> Result<PathBuf, String> {
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ sits in the workspace");
+    for (tool, install) in [
+        ("verilator", "apt-get install verilator"),
+        ("python3", "apt-get install python3 python3-venv"),
+    ] {
+        let found = Command::new(tool)
+            .arg("--version")
+            .output()
+            .is_ok_and(|out| out.status.success());
+        if !found {
+            return Err(format!("`{tool}` not found on PATH ({install})"));
+        }
+    }
+    let out = workspace.join("target").join("soc");
+    let built = Command::new("bash")
+        .arg(workspace.join("hdl-interface/soc/build.sh"))
+        .arg(&out)
+        .output()
+        .map_err(|e| format!("cannot run hdl-interface/soc/build.sh: {e}"))?;
+    if !built.status.success() {
+        return Err(format!(
+            "hdl-interface/soc/build.sh failed (network for pip, python3-venv?): {}",
+            String::from_utf8_lossy(&built.stderr).trim()
+        ));
+    }
+    Ok(out.join("sc_soc_sim"))
+}
+
 /// The soft-core's Rust target: the firmware ELF is built for it.
 pub const FIRMWARE_TARGET: &str = "riscv32imc-unknown-none-elf";
 

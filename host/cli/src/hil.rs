@@ -40,12 +40,18 @@ pub struct HilArgs {
     /// The QEMU binary.
     #[arg(long, default_value = DEFAULT_QEMU)]
     qemu: PathBuf,
+    /// Run the ELF on the SoC in the loop instead of QEMU: a real RV32IMAC core (VexRiscv)
+    /// under Verilator, the simulator `bash hdl-interface/soc/build.sh DIR` builds as
+    /// DIR/sc_soc_sim.
+    #[arg(long, value_name = "SC_SOC_SIM")]
+    soc: Option<PathBuf>,
     /// Seconds to wait for one answer or frame pair from the emulated device.
     #[arg(long, default_value_t = QemuTimeouts::default().answer.as_secs(),
           value_parser = clap::value_parser!(u64).range(1..=86_400))]
     timeout: u64,
-    /// Run with `-icount shift=0` and print the soft-core's instructions per pixel, and per
-    /// pair its program's own (`softcore_instructions_per_pair` in `--json`).
+    /// Count instructions (QEMU: with `-icount shift=0`; the SoC's core counts them itself)
+    /// and print the soft-core's instructions per pixel, and per pair its program's own
+    /// (`softcore_instructions_per_pair` in `--json`).
     #[arg(long)]
     count_instructions: bool,
     /// Print the firmware's log messages (decoded with the ELF's defmt table) on stderr.
@@ -72,6 +78,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
     let qemu = QemuConfig {
         qemu: args.qemu.clone(),
         count_instructions: args.count_instructions,
+        soc: args.soc.clone(),
         timeouts: QemuTimeouts {
             answer: Duration::from_secs(args.timeout),
             ..QemuTimeouts::default()
@@ -79,7 +86,12 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
         ..QemuConfig::new(&args.elf)
     };
 
-    let bar = progress_bar(sequence.len() as u64, "soft-core under QEMU");
+    let machine = if args.soc.is_some() {
+        "soft-core on the SoC (Verilator)"
+    } else {
+        "soft-core under QEMU"
+    };
+    let bar = progress_bar(sequence.len() as u64, machine);
     let run = run_sequence(
         &qemu,
         &sequence,

@@ -80,6 +80,12 @@ pub struct QemuConfig {
     pub elf: PathBuf,
     /// Run with `-icount shift=0` and have the firmware log every image's instruction counts.
     pub count_instructions: bool,
+    /// Run the ELF on the SoC in the loop instead of QEMU: the simulator `sc_soc_sim` that
+    /// `bash hdl-interface/soc/build.sh DIR` builds (a real RV32IMAC core, VexRiscv, under
+    /// Verilator, with the `virt` machine's RAM, UART and finisher). It takes the same ELF, the
+    /// same frame file and speaks on the same kind of socket; its `minstret` counts retired
+    /// instructions without `-icount`.
+    pub soc: Option<PathBuf>,
     /// The timeouts.
     pub timeouts: QemuTimeouts,
 }
@@ -91,6 +97,7 @@ impl QemuConfig {
             qemu: DEFAULT_QEMU.into(),
             elf: elf.into(),
             count_instructions: false,
+            soc: None,
             timeouts: QemuTimeouts::default(),
         }
     }
@@ -208,44 +215,34 @@ impl QemuDevice {
         })?;
         let socket = dir.path().join("uart.sock");
 
-        let mut command = Command::new(&config.qemu);
-        command
-            .args(["-machine", "virt", "-m", "128M", "-bios", "none"])
-            .args(["-display", "none", "-monitor", "none"])
-            .arg("-kernel")
-            .arg(&config.elf)
-            .arg("-chardev")
-            .arg(format!(
-                "socket,id=uart,path={},server=on,wait=on",
-                option_value(&socket)
-            ))
-            .args(["-serial", "chardev:uart"])
-            .arg("-device")
-            .arg(format!(
-                "loader,file={},addr={VIRT_FRAME_REGION:#x}",
-                option_value(&frames)
-            ));
-        if config.count_instructions {
-            command.args(["-icount", "shift=0"]);
-        }
+        let mut command = match &config.soc {
+            Some(sim) => soc_command(sim, &config.elf, &socket, &frames),
+            None => qemu_command(config, &socket, &frames),
+        };
+        let program = config.soc.as_ref().unwrap_or(&config.qemu);
         let mut child = command
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
             .spawn()
             .map_err(|source| HilError::Spawn {
-                program: config.qemu.clone(),
+                program: program.clone(),
                 source,
             })?;
         let stderr = child.stderr.take().map(|mut pipe| {
             std::thread::spawn(move || {
                 let mut text = String::new();
-                // Whatever could be read is what QEMU said; a broken pipe ends it.
+                // Whatever could be read is what the machine said; a broken pipe ends it.
                 let _ = pipe.read_to_string(&mut text);
                 text
             })
         });
         let mut process = Process { child, stderr };
+        let machine = if config.soc.is_some() {
+            "the SoC simulator"
+        } else {
+            "QEMU"
+        };
 
         let deadline = Instant::now() + config.timeouts.startup;
         let stream = loop {
@@ -262,7 +259,10 @@ impl QemuDevice {
                     return Err(HilError::Timeout {
                         kind: TimeoutKind::Startup,
                         limit: config.timeouts.startup,
-                        waiting_for: format!("QEMU to open its UART socket {}", socket.display()),
+                        waiting_for: format!(
+                            "{machine} to open its UART socket {}",
+                            socket.display()
+                        ),
                     })
                 }
             }
@@ -270,7 +270,7 @@ impl QemuDevice {
         Ok(Self {
             link: Recording::new(StreamLink::from_stream(
                 stream,
-                format!("QEMU UART {}", socket.display()),
+                format!("{machine} UART {}", socket.display()),
             )),
             process,
             loaded: input.digests.clone(),
@@ -378,6 +378,45 @@ impl FrameInput for QemuDevice {
         self.submitted += 1;
         Ok(())
     }
+}
+
+/// QEMU's command line (the module docs).
+fn qemu_command(config: &QemuConfig, socket: &Path, frames: &Path) -> Command {
+    let mut command = Command::new(&config.qemu);
+    command
+        .args(["-machine", "virt", "-m", "128M", "-bios", "none"])
+        .args(["-display", "none", "-monitor", "none"])
+        .arg("-kernel")
+        .arg(&config.elf)
+        .arg("-chardev")
+        .arg(format!(
+            "socket,id=uart,path={},server=on,wait=on",
+            option_value(socket)
+        ))
+        .args(["-serial", "chardev:uart"])
+        .arg("-device")
+        .arg(format!(
+            "loader,file={},addr={VIRT_FRAME_REGION:#x}",
+            option_value(frames)
+        ));
+    if config.count_instructions {
+        command.args(["-icount", "shift=0"]);
+    }
+    command
+}
+
+/// The SoC simulator's command line (`hdl-interface/soc/sim/sc_soc_sim.cpp`): the same ELF,
+/// frame file and socket as QEMU's.
+fn soc_command(sim: &Path, elf: &Path, socket: &Path, frames: &Path) -> Command {
+    let mut command = Command::new(sim);
+    command
+        .arg("--elf")
+        .arg(elf)
+        .arg("--uart")
+        .arg(socket)
+        .arg("--load")
+        .arg(format!("{}@{VIRT_FRAME_REGION:#x}", frames.display()));
+    command
 }
 
 #[cfg(test)]
