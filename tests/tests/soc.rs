@@ -1,12 +1,12 @@
 //! The firmware ELF on the SoC in the loop: the release ELF that QEMU runs, on a real
-//! RV32IMAC core (VexRiscv from PyPI) under Verilator with the `virt` machine's RAM, UART and
+//! RV32IMAC core (VexRiscv from PyPI) with both channels' `sc_fabric` and stream engines on
+//! its bus, cameras wired to them, under Verilator with the `virt` machine's RAM, UART and
 //! finisher around it (`hdl-interface/soc/`), speaking to the same host driver and session.
-//! Its UART bytes must be the in-process device's, as QEMU's are (`tests/tests/qemu.rs`), and
-//! its records equal to the bit.
+//! The bytes on its link (the UART and both LINK_OUT ports) must be the in-process device's,
+//! as QEMU's are (`tests/tests/qemu.rs`), and its records equal to the bit.
 //!
 //! Needs verilator, python3 with venv and, on the first run, network for pip; builds the
-//! simulator and the ELF itself. The soft-core runs the fabric's software model here, about
-//! 1.5 million clocks a second on this project's machines: the frames are small.
+//! simulator and the ELF itself.
 
 use stereocal::session::SessionConfig;
 use stereocal_hil::{
@@ -20,7 +20,7 @@ fn soc_runs_the_release_elf_and_sends_the_in_process_bytes() {
     let Some(soc) = soc_or_skip(test) else {
         return;
     };
-    let scenario = Scenario::synthetic(SceneKind::Road, 64, 48, 1, SessionConfig::default());
+    let scenario = Scenario::synthetic(SceneKind::Road, 128, 96, 2, SessionConfig::default());
     let reference = run_in_process(&scenario);
     let (on_soc, run) = run_qemu(&scenario, &soc).unwrap_or_else(|e| panic!("{test}: {e}"));
     assert!(run.end.exit.is_success(), "{test}: {}", run.end.exit);

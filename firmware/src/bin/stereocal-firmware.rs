@@ -15,7 +15,7 @@
 //!    `FLAG_COUNT_INSTRUCTIONS` each image's instruction counts follow as a log packet, and
 //!    after the last frame the row kernels' counts on the first image
 //!    (`softcore::instructions`), preceded by the main loop's stack high-water mark
-//!    (`softcore::stack`: the free stack is painted first thing at boot).
+//!    (`softcore::stack`: the free stack is painted as soon as the input says to count).
 //! 4. Exit through the `sifive_test` finisher: 0 when every frame ran, 2 for a bad input
 //!    region, 3 when a frame failed (an `ErrorReport` says why), 101 on a panic.
 //!
@@ -43,13 +43,13 @@ mod soft_core {
     use stereocal_firmware::softcore::finisher::{self, ExitCode};
     use stereocal_firmware::softcore::frame_input::{
         FrameInput, InputHeader, FLAG_AUTOSTART, FLAG_COUNT_INSTRUCTIONS, FLAG_REGISTER_MODEL,
-        VIRT_FRAME_REGION, VIRT_FRAME_REGION_LEN,
+        FLAG_WIRED_CAMERAS, VIRT_FRAME_REGION, VIRT_FRAME_REGION_LEN,
     };
     use stereocal_firmware::softcore::instructions::{self, CountedFabric, InstructionReport};
     use stereocal_firmware::softcore::link::{Uart0, LINK};
     use stereocal_firmware::softcore::stack::{self, StackReport};
+    use stereocal_firmware::softcore::wired::{ChannelFabric, ModelFabric, WiredFabric};
     use stereocal_hdl::regs::{control, height, width};
-    use stereocal_hdl::RegisterBus;
     use stereocal_wire::{
         Accumulator, Camera, Capabilities, ErrorCode, ErrorReportRepr, FeedResult, HelloRepr,
         PacketRepr, PROTOCOL_VERSION,
@@ -57,9 +57,10 @@ mod soft_core {
 
     /// One camera channel: the driver, on the registers and PIXEL_IN port of the fabric's
     /// device model (everything the model does counted in instructions), whose stream engine
-    /// sends on the UART as the fabric's LINK_OUT would. The driver reaches it only through
-    /// the register bus, as it would reach a fabric's registers by MMIO.
-    type Channel = Driver<CountedFabric<FabricDevice<FabricModel, 1280, Uart0>>>;
+    /// sends on the UART as the fabric's LINK_OUT would; or, on the SoC in the loop with
+    /// wired cameras, on the real fabric's registers at MMIO. The driver reaches either only
+    /// through the register bus.
+    type Channel<F> = Driver<F>;
 
     /// Host packets are short (a RegisterWrite is 16 framed bytes); a longer frame is refused.
     type HostAccumulator = Accumulator<64>;
@@ -94,15 +95,29 @@ mod soft_core {
         unsafe { finisher::exit(code) }
     }
 
-    /// A channel for `camera` whose WIDTH/HEIGHT match the input frames.
-    fn channel(header: &InputHeader, camera: Camera) -> Channel {
+    /// A channel for `camera` on the device model.
+    fn model_channel(header: &InputHeader, camera: Camera) -> Channel<ModelFabric> {
         let model = if header.has_flag(FLAG_REGISTER_MODEL) {
             FabricModel::register_level()
         } else {
             FabricModel::fast()
         };
         let fabric = CountedFabric::new(FabricDevice::with_link(model, Uart0::new()));
-        let mut channel = Driver::new(fabric, camera).with_capabilities(Capabilities::LOG);
+        configured(header, Driver::new(fabric, camera))
+    }
+
+    /// A channel for `camera` on the real fabric of the SoC in the loop.
+    fn wired_channel(header: &InputHeader, camera: Camera) -> Channel<WiredFabric> {
+        // SAFETY: the input says the board is the SoC in the loop, whose bus has each
+        // camera's fabric where `WiredFabric` looks.
+        let fabric = unsafe { WiredFabric::new(u8::from(camera).into()) };
+        configured(header, Driver::new(fabric, camera))
+    }
+
+    /// `channel` with the soft-core's capabilities, WIDTH/HEIGHT matching the input frames and,
+    /// when the input asks to autostart, CONTROL.ENABLE set.
+    fn configured<F: ChannelFabric>(header: &InputHeader, channel: Channel<F>) -> Channel<F> {
+        let mut channel = channel.with_capabilities(Capabilities::LOG);
         let bus = channel.bus_mut();
         let geometry = bus
             .write_field(&width::VALUE, header.width.into())
@@ -120,9 +135,9 @@ mod soft_core {
 
     /// Answers every host packet received so far; with `wait`, also waits for more packets
     /// while CONTROL.ENABLE is 0.
-    fn serve_host(
+    fn serve_host<F: ChannelFabric>(
         acc: &mut HostAccumulator,
-        channels: &mut [Channel],
+        channels: &mut [Channel<F>],
         last_good_seq: &mut u16,
         wait: bool,
     ) {
@@ -174,7 +189,6 @@ mod soft_core {
 
     #[riscv_rt::entry]
     fn main() -> ! {
-        stack::paint();
         Uart0::device().init();
         // SAFETY: the region is RAM above the program (memory.x) that nothing writes while the
         // firmware runs; QEMU's loader filled it before the hart started.
@@ -190,14 +204,37 @@ mod soft_core {
             }
         };
         let header = *input.header();
-        let mut channels = [
-            channel(&header, Camera::Left),
-            channel(&header, Camera::Right),
-        ];
+        // The stack is measured only for the instruction-count report: painting megabytes of
+        // free stack costs a slow core (the SoC in the loop) millions of clocks.
+        let measure_stack = header.has_flag(FLAG_COUNT_INSTRUCTIONS);
+        if measure_stack {
+            stack::paint();
+        }
+        if header.has_flag(FLAG_WIRED_CAMERAS) {
+            let channels = [
+                wired_channel(&header, Camera::Left),
+                wired_channel(&header, Camera::Right),
+            ];
+            run(&input, channels)
+        } else {
+            let channels = [
+                model_channel(&header, Camera::Left),
+                model_channel(&header, Camera::Right),
+            ];
+            run(&input, channels)
+        }
+    }
+
+    /// Runs every frame of `input` through `channels`, then stops the machine.
+    fn run<F: ChannelFabric>(input: &FrameInput<'_>, mut channels: [Channel<F>; 2]) -> ! {
+        let header = *input.header();
+        let measure_stack = header.has_flag(FLAG_COUNT_INSTRUCTIONS);
         // Boot is the deepest the stack goes (the channels are built by value); paint again
         // so that the mark after the frames is the main loop's own.
         let (boot_stack, _) = stack::high_water();
-        stack::paint();
+        if measure_stack {
+            stack::paint();
+        }
         // `FrameInput::new` checked that there are 1 or 2 cameras.
         let Some(channels) = channels.get_mut(..usize::from(header.cameras)) else {
             stop(ExitCode::BadInput);
@@ -216,17 +253,17 @@ mod soft_core {
                     // `FrameInput::new` checked that every image is in the region.
                     stop(ExitCode::BadInput);
                 };
-                channel.bus().take();
-                channel.bus_mut().inner_mut().link_mut().take_waited();
+                channel.bus().take_counted();
+                channel.bus_mut().take_link_waited();
                 with_link(|link| link.sink_mut().take_waited());
                 let start = instructions::instret();
                 let result = channel.process_frame(image.pixels, image.timestamp_us);
                 let spent = instructions::instret().wrapping_sub(start);
                 // The stream engine's waits for the transmitter are inside the fabric's count.
-                let link_wait = channel.bus_mut().inner_mut().link_mut().take_waited();
+                let link_wait = channel.bus_mut().take_link_waited();
                 match result {
                     Ok(summary) if header.has_flag(FLAG_COUNT_INSTRUCTIONS) => {
-                        let front_end = channel.bus().take().wrapping_sub(link_wait);
+                        let front_end = channel.bus().take_counted().wrapping_sub(link_wait);
                         let uart_wait =
                             with_link(|link| link.sink_mut().take_waited()).wrapping_add(link_wait);
                         instructions::log(&InstructionReport {

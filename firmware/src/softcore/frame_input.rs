@@ -20,7 +20,8 @@
 //! with the register reset values instead of waiting for the host to set `CONTROL.ENABLE`;
 //! bit 1 ([`FLAG_REGISTER_MODEL`]) runs the register-level fabric model instead of the fast
 //! path; bit 2 ([`FLAG_COUNT_INSTRUCTIONS`]) reports every image's instruction counts in a
-//! `Log` packet (and after the last frame the stack high-water marks, `super::stack`).
+//! `Log` packet (and after the last frame the stack high-water marks, `super::stack`); bit 3
+//! ([`FLAG_WIRED_CAMERAS`]) says the board's cameras are wired to a real fabric.
 //! Other bits must be 0.
 
 /// Start of the input region on the QEMU `virt` machine (16 MiB into DRAM, above the
@@ -46,7 +47,13 @@ pub const FLAG_REGISTER_MODEL: u16 = 1 << 1;
 /// are packets the in-process device does not send, so a run with them is not byte-identical
 /// to it.
 pub const FLAG_COUNT_INSTRUCTIONS: u16 = 1 << 2;
-const KNOWN_FLAGS: u16 = FLAG_AUTOSTART | FLAG_REGISTER_MODEL | FLAG_COUNT_INSTRUCTIONS;
+/// The board is the SoC in the loop with its cameras wired to the fabric
+/// (`hdl-interface/soc/`): the channels drive the real fabric at MMIO
+/// ([`super::wired`]) and the images here are what the cameras send, not what the driver
+/// offers.
+pub const FLAG_WIRED_CAMERAS: u16 = 1 << 3;
+const KNOWN_FLAGS: u16 =
+    FLAG_AUTOSTART | FLAG_REGISTER_MODEL | FLAG_COUNT_INSTRUCTIONS | FLAG_WIRED_CAMERAS;
 
 /// What is wrong with an input region.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

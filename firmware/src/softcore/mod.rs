@@ -47,6 +47,8 @@ pub mod link;
 mod logger;
 #[cfg(target_os = "none")]
 pub mod panic;
+#[cfg(target_os = "none")]
+pub mod wired;
 
 #[cfg(target_os = "none")]
 pub use logger::dropped_logs;

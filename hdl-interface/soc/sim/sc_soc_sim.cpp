@@ -3,7 +3,8 @@
 // `virt` machine, so that the firmware ELF QEMU runs runs here unchanged, and it is started
 // and spoken to as the host's QEMU link starts and speaks to QEMU:
 //
-//   sc_soc_sim --elf ELF --uart SOCKET [--load FILE@ADDR]... [--ram-mib N] [--max-cycles N]
+//   sc_soc_sim --elf ELF --uart SOCKET [--load FILE@ADDR]... [--frames FILE]
+//              [--ram-mib N] [--max-cycles N] [--pixel-clock-divider N] [--line-blank N]
 //
 // - RAM at 0x8000_0000 (--ram-mib, 128 as QEMU's default -m): the ELF's PT_LOAD segments and
 //   every --load file are copied in before reset (QEMU's -kernel and -device loader).
@@ -13,13 +14,26 @@
 //   client at, as QEMU's `-chardev socket,server=on,wait=on`.
 // - `sifive_test` finisher at 0x0010_0000: 0x5555 ends the run with exit status 0, 0x3333
 //   with the status in bits 31..16, as QEMU does.
-// - Any other address answers with a bus error (the core takes an access fault).
+// - The fabrics (0x4000_0000, sc_soc.v) are in the Verilog; any other address answers with a
+//   bus error (the core takes an access fault).
+// - The cameras (--frames, the frame-grabber file whose layout is the firmware's
+//   softcore/frame_input.rs): camera c sends the file's images of camera c in order. A
+//   camera is triggered: it starts an image on the first pixel clock its fabric's PIXEL_IN
+//   is ready (the fabric armed, waiting for SOF), then sends one pixel per pixel clock, each
+//   line followed by --line-blank pixel clocks (default 16), and never waits: a pixel the
+//   fabric does not take ends the run with status 125 and a message. A pixel clock is one
+//   clock in --pixel-clock-divider (default 64; the stream engine's pace, docs/
+//   STREAM_ENGINE.md).
+// - The link: the UART's bytes and both LINK_OUT ports share the socket at link-frame
+//   boundaries: a source that has begun a frame keeps the socket until its 0x00 delimiter,
+//   the others' bytes wait (a link arbiter; LINK_OUT is always ready).
 // - --max-cycles (default: none) ends a run that did not finish with exit status 124 and a
 //   message naming the limit; the host side reports it as a timeout.
 //
 // Both buses get zero-wait-state answers: the harness acknowledges every clock on which a
 // bus holds STB, one transfer per acknowledged clock, so a register read has exactly one
-// effect. On exit it prints to stderr one line `sc_soc_sim: cycles N seconds S`.
+// effect. On exit it prints to stderr one line `sc_soc_sim: cycles N seconds S fabric_reads N
+// fabric_writes N`.
 
 #include <elf.h>
 #include <errno.h>
@@ -143,8 +157,51 @@ struct Uart {
     }
 };
 
+/// The link arbiter: whole link frames from each source, in the order they begin.
+struct Link {
+    std::deque<uint8_t> queue[3];   // UART, LINK_OUT 0, LINK_OUT 1
+    int owner = -1;
+    Uart *uart = nullptr;
+
+    void push(int source, uint8_t byte) {
+        queue[source].push_back(byte);
+        pump();
+    }
+
+    void pump() {
+        for (;;) {
+            if (owner < 0) {
+                for (int s = 0; s < 3 && owner < 0; s++)
+                    if (!queue[s].empty()) owner = s;
+                if (owner < 0) return;
+            }
+            std::deque<uint8_t> &q = queue[owner];
+            while (!q.empty()) {
+                uint8_t b = q.front();
+                q.pop_front();
+                uart->send(b);
+                if (b == 0) {
+                    owner = -1;
+                    break;
+                }
+            }
+            if (owner >= 0) return;   // the frame goes on later
+        }
+    }
+};
+
+/// The images of one camera from a frame-grabber file.
+struct Camera {
+    std::vector<const uint8_t *> images;
+    size_t next = 0;     // image to send next
+    size_t at = 0;       // pixel of the current image; 0 and !sending: waiting for the trigger
+    bool sending = false;
+    uint64_t blank = 0;  // pixel clocks of line blanking left
+};
+
 struct Args {
-    std::string elf, uart;
+    std::string elf, uart, frames;
+    uint64_t divider = 64, line_blank = 16;
     std::vector<std::pair<std::string, uint32_t>> loads;
     uint64_t ram_mib = 128;
     uint64_t max_cycles = 0;
@@ -168,6 +225,16 @@ Args parse(int argc, char **argv) {
             if (at == std::string::npos) die("--load wants FILE@ADDR, got " + v);
             a.loads.emplace_back(v.substr(0, at),
                                  uint32_t(std::strtoul(v.c_str() + at + 1, nullptr, 0)));
+        } else if (k == "--frames") {
+            a.frames = value();
+        } else if (k == "--pixel-clock-divider") {
+            a.divider = std::strtoull(value().c_str(), nullptr, 0);
+            // The firmware's waits for a camera allow 4096 core clocks per pixel clock
+            // (softcore/wired.rs, MAX_CORE_CLOCKS_PER_PIXEL).
+            if (a.divider == 0 || a.divider > 4096)
+                die("--pixel-clock-divider must be 1 to 4096");
+        } else if (k == "--line-blank") {
+            a.line_blank = std::strtoull(value().c_str(), nullptr, 0);
         } else if (k == "--ram-mib") {
             a.ram_mib = std::strtoull(value().c_str(), nullptr, 0);
         } else if (k == "--max-cycles") {
@@ -191,8 +258,32 @@ int main(int argc, char **argv) {
         std::vector<uint8_t> data = read_file(path);
         ram.load(addr, data.data(), data.size(), path);
     }
+    // The cameras' images: the frame-grabber file's header (magic, version, cameras, width,
+    // height, flags, frame_count), then per frame one record per camera (timestamp, pixels).
+    std::vector<uint8_t> frames;
+    Camera cams[2];
+    uint32_t width = 0, height = 0;
+    if (!args.frames.empty()) {
+        frames = read_file(args.frames);
+        if (frames.size() < 16 || std::memcmp(frames.data(), "SCFI", 4) != 0)
+            die(args.frames + ": not a frame-grabber file");
+        uint32_t cameras = frames[5];
+        width = frames[6] | (frames[7] << 8);
+        height = frames[8] | (frames[9] << 8);
+        uint32_t count;
+        std::memcpy(&count, &frames[12], 4);
+        size_t record = 8 + size_t(width) * height, off = 16;
+        if (cameras < 1 || cameras > 2 || off + record * cameras * count > frames.size())
+            die(args.frames + ": truncated or not 1 or 2 cameras");
+        for (uint32_t f = 0; f < count; f++)
+            for (uint32_t c = 0; c < cameras; c++, off += record)
+                cams[c].images.push_back(&frames[off + 8]);
+    }
+
     Uart uart;
     uart.listen_and_accept(args.uart);
+    Link link;
+    link.uart = &uart;
 
     VerilatedContext ctx;
     Vsc_soc top{&ctx};
@@ -217,8 +308,12 @@ int main(int argc, char **argv) {
 
     while (exit_status < 0) {
         if (args.max_cycles && cycle >= args.max_cycles) {
-            std::fprintf(stderr, "sc_soc_sim: the firmware did not finish within %llu cycles\n",
-                         static_cast<unsigned long long>(args.max_cycles));
+            std::fprintf(stderr, "sc_soc_sim: the firmware did not finish within %llu cycles "
+                         "(data bus %s at 0x%08x, instruction bus %s at 0x%08x)\n",
+                         static_cast<unsigned long long>(args.max_cycles),
+                         top.dbus_cyc ? (top.dbus_we ? "writing" : "reading") : "idle",
+                         unsigned(top.dbus_adr) << 2, top.ibus_cyc ? "fetching" : "idle",
+                         unsigned(top.ibus_adr) << 2);
             exit_status = 124;
             break;
         }
@@ -260,7 +355,7 @@ int main(int argc, char **argv) {
                     uint32_t reg = addr - UART_BASE + b;
                     uint8_t v = 0;
                     if (top.dbus_we) {
-                        if (reg == 0) uart.send(uint8_t(wdata >> (8 * b)));
+                        if (reg == 0) link.push(0, uint8_t(wdata >> (8 * b)));
                     } else if (reg == 0) {
                         if (uart.rx.empty()) uart.poll_rx();
                         if (!uart.rx.empty()) {
@@ -291,14 +386,67 @@ int main(int argc, char **argv) {
                 top.dbus_err = 1;
             }
         }
+        // The cameras, on pixel clocks: each offers its pixel (a waiting camera the first
+        // pixel of its next image) and it is taken when PIXEL_IN is ready on this clock.
+        bool ce = cycle % args.divider == 0;
+        top.pix_ce = ce;
+        top.link_ready = 3;
+        uint32_t cam_data = 0, valid = 0, sof = 0, eol = 0;
+        for (int c = 0; c < 2 && ce; c++) {
+            Camera &cam = cams[c];
+            if (cam.sending && cam.blank > 0) {
+                cam.blank--;
+                continue;
+            }
+            if (!cam.sending && cam.next >= cam.images.size()) continue;
+            size_t at = cam.sending ? cam.at : 0;
+            cam_data |= uint32_t(cam.images[cam.next][at]) << (8 * c);
+            valid |= 1u << c;
+            if (at == 0) sof |= 1u << c;
+            if ((at + 1) % width == 0) eol |= 1u << c;
+        }
+        top.cam_data = cam_data;
+        top.cam_valid = valid;
+        top.cam_sof = sof;
+        top.cam_eol = eol;
+        top.clk = 0;
         top.eval();
-        edge();
+        for (int c = 0; c < 2; c++) {
+            if ((top.link_valid >> c) & 1) link.push(1 + c, uint8_t(top.link_data >> (8 * c)));
+            if (!((valid >> c) & 1)) continue;
+            Camera &cam = cams[c];
+            bool taken = (top.cam_ready >> c) & 1;
+            if (!taken) {
+                if (!cam.sending) continue;   // not triggered yet: the fabric is not armed
+                std::fprintf(stderr,
+                             "sc_soc_sim: camera %d: pixel %zu of image %zu not taken (the "
+                             "fabric was not ready)\n",
+                             c, cam.at, cam.next);
+                exit_status = 125;
+                continue;
+            }
+            if (!cam.sending) {
+                cam.sending = true;
+                cam.at = 0;
+            }
+            cam.at++;
+            if (cam.at % width == 0) cam.blank = args.line_blank;
+            if (cam.at == size_t(width) * height) {
+                cam.sending = false;
+                cam.blank = 0;
+                cam.next++;
+            }
+        }
+        top.clk = 1;
+        top.eval();
+        cycle++;
     }
 
     double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::fprintf(stderr, "sc_soc_sim: cycles %llu seconds %.3f\n",
-                 static_cast<unsigned long long>(cycle), seconds);
+    std::fprintf(stderr, "sc_soc_sim: cycles %llu seconds %.3f fabric_reads %u fabric_writes %u\n",
+                 static_cast<unsigned long long>(cycle), seconds, unsigned(top.fabric_reads),
+                 unsigned(top.fabric_writes));
     top.final();
     if (uart.fd >= 0) close(uart.fd);
     return exit_status;

@@ -9,9 +9,7 @@
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 
-use stereocal_firmware::softcore::frame_input::{
-    InputHeader, FLAG_COUNT_INSTRUCTIONS, HEADER_LEN, VIRT_FRAME_REGION_LEN,
-};
+use stereocal_firmware::softcore::frame_input::{InputHeader, HEADER_LEN, VIRT_FRAME_REGION_LEN};
 
 use super::HilError;
 
@@ -102,14 +100,11 @@ impl GrabberInput {
         Ok(())
     }
 
-    /// The region's bytes: the header, then every image record. With `count_instructions`
-    /// the firmware logs each image's instruction counts.
-    pub fn to_bytes(&self, count_instructions: bool) -> Vec<u8> {
-        let flags = if count_instructions {
-            FLAG_COUNT_INSTRUCTIONS
-        } else {
-            0
-        };
+    /// The region's bytes: the header with `flags` (`frame_input`'s `FLAG_*`: with
+    /// `FLAG_COUNT_INSTRUCTIONS` the firmware logs each image's instruction counts, with
+    /// `FLAG_WIRED_CAMERAS` the board's cameras send the images to a real fabric), then every
+    /// image record.
+    pub fn to_bytes(&self, flags: u16) -> Vec<u8> {
         let header = self.header(flags, self.pairs() as u64);
         let mut bytes = Vec::with_capacity(HEADER_LEN + self.records.len());
         bytes.extend_from_slice(&header.emit());
@@ -133,19 +128,20 @@ impl GrabberInput {
 mod tests {
     use super::*;
     use stereocal_firmware::softcore::frame_input::FrameInput;
+    use stereocal_firmware::softcore::frame_input::FLAG_COUNT_INSTRUCTIONS;
 
     #[test]
     fn the_firmware_reads_what_is_written() {
         let mut input = GrabberInput::new(4, 2);
         input.push_pair(&[1; 8], &[2; 8], 100).unwrap();
         input.push_pair(&[3; 8], &[4; 8], 200).unwrap();
-        let bytes = input.to_bytes(true);
+        let bytes = input.to_bytes(FLAG_COUNT_INSTRUCTIONS);
         let region = FrameInput::new(&bytes).unwrap();
         assert_eq!(region.header().frame_count, 2);
         assert!(region.header().has_flag(FLAG_COUNT_INSTRUCTIONS));
         let right1 = region.image(1, 1).unwrap();
         assert_eq!((right1.timestamp_us, right1.pixels), (200, &[4u8; 8][..]));
-        assert!(!FrameInput::new(&input.to_bytes(false))
+        assert!(!FrameInput::new(&input.to_bytes(0))
             .unwrap()
             .header()
             .has_flag(FLAG_COUNT_INSTRUCTIONS));

@@ -29,7 +29,9 @@ use std::process::{Child, Command, Stdio};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use stereocal_firmware::softcore::frame_input::VIRT_FRAME_REGION;
+use stereocal_firmware::softcore::frame_input::{
+    FLAG_COUNT_INSTRUCTIONS, FLAG_WIRED_CAMERAS, VIRT_FRAME_REGION,
+};
 
 use super::input::PairDigest;
 use super::{FirmwareExit, GrabberInput, HilError, TimeoutKind};
@@ -81,10 +83,12 @@ pub struct QemuConfig {
     /// Run with `-icount shift=0` and have the firmware log every image's instruction counts.
     pub count_instructions: bool,
     /// Run the ELF on the SoC in the loop instead of QEMU: the simulator `sc_soc_sim` that
-    /// `bash hdl-interface/soc/build.sh DIR` builds (a real RV32IMAC core, VexRiscv, under
-    /// Verilator, with the `virt` machine's RAM, UART and finisher). It takes the same ELF, the
-    /// same frame file and speaks on the same kind of socket; its `minstret` counts retired
-    /// instructions without `-icount`.
+    /// `bash hdl-interface/soc/build.sh DIR` builds (a real RV32IMAC core, VexRiscv, and both
+    /// channels' `sc_fabric` on its bus, under Verilator, with the `virt` machine's RAM, UART
+    /// and finisher). It takes the same ELF and frame file and speaks on the same kind of
+    /// socket; the frame file says the cameras are wired (`FLAG_WIRED_CAMERAS`), so the
+    /// firmware drives the real fabric and the harness's cameras send the images. Its
+    /// `minstret` counts retired instructions without `-icount`.
     pub soc: Option<PathBuf>,
     /// The timeouts.
     pub timeouts: QemuTimeouts,
@@ -207,11 +211,16 @@ impl QemuDevice {
                 source,
             })?;
         let frames = dir.path().join("frames.bin");
-        std::fs::write(&frames, input.to_bytes(config.count_instructions)).map_err(|source| {
-            HilError::File {
-                path: frames.clone(),
-                source,
-            }
+        let mut flags = 0;
+        if config.count_instructions {
+            flags |= FLAG_COUNT_INSTRUCTIONS;
+        }
+        if config.soc.is_some() {
+            flags |= FLAG_WIRED_CAMERAS;
+        }
+        std::fs::write(&frames, input.to_bytes(flags)).map_err(|source| HilError::File {
+            path: frames.clone(),
+            source,
         })?;
         let socket = dir.path().join("uart.sock");
 
@@ -415,7 +424,9 @@ fn soc_command(sim: &Path, elf: &Path, socket: &Path, frames: &Path) -> Command 
         .arg("--uart")
         .arg(socket)
         .arg("--load")
-        .arg(format!("{}@{VIRT_FRAME_REGION:#x}", frames.display()));
+        .arg(format!("{}@{VIRT_FRAME_REGION:#x}", frames.display()))
+        .arg("--frames")
+        .arg(frames);
     command
 }
 
