@@ -99,7 +99,9 @@ impl DescriptorSet {
     }
 }
 
-/// Gaussian weighting σ of the window (half its width), in window pixels.
+/// Gaussian weighting σ of the window (half its width), in window pixels: Lowe's (2004, 6.1),
+/// so that the descriptor changes smoothly as the window shifts and the gradients far from the
+/// centre, most affected by misregistration, weigh least.
 const WINDOW_SIGMA: f32 = (PATCH_SIZE / 2) as f32;
 /// Lowe's clamp of normalised descriptor elements.
 const CLAMP: f32 = 0.2;
@@ -153,28 +155,30 @@ fn offset(i: usize) -> (f32, f32) {
 /// Dominant gradient orientation (radians) from a Gaussian-weighted 64-bin histogram,
 /// smoothed and peak-interpolated.
 fn dominant_orientation(window: &[(u8, u8)]) -> f32 {
-    let steps = ORIENTATION_STEPS as usize;
-    let mut h = [0f32; 64];
+    // One bin per orientation code of the fabric: its whole angular resolution.
+    const STEPS: usize = ORIENTATION_STEPS as usize;
+    let mut h = [0f32; STEPS];
     for (i, &(m, o)) in window.iter().enumerate() {
         let (x, y) = offset(i);
         let g = (-(x * x + y * y) / (2.0 * (0.75 * WINDOW_SIGMA).powi(2))).exp();
-        h[o as usize % steps] += m as f32 * g;
+        h[o as usize % STEPS] += m as f32 * g;
     }
-    let smooth: [f32; 64] =
-        std::array::from_fn(|i| 0.25 * h[(i + 63) % 64] + 0.5 * h[i] + 0.25 * h[(i + 1) % 64]);
+    let smooth: [f32; STEPS] = std::array::from_fn(|i| {
+        0.25 * h[(i + STEPS - 1) % STEPS] + 0.5 * h[i] + 0.25 * h[(i + 1) % STEPS]
+    });
     let (best, _) =
         smooth.iter().enumerate().fold(
             (0, f32::MIN),
             |acc, (i, &v)| if v > acc.1 { (i, v) } else { acc },
         );
     let (l, c, r) = (
-        smooth[(best + 63) % 64],
+        smooth[(best + STEPS - 1) % STEPS],
         smooth[best],
-        smooth[(best + 1) % 64],
+        smooth[(best + 1) % STEPS],
     );
     let den = l - 2.0 * c + r;
     let frac = if den < 0.0 { 0.5 * (l - r) / den } else { 0.0 };
-    (best as f32 + frac) * std::f32::consts::TAU / steps as f32
+    (best as f32 + frac) * std::f32::consts::TAU / STEPS as f32
 }
 
 /// Trilinear accumulation of the window into `hist` (cells × cells × bins), in a frame rotated
@@ -349,6 +353,8 @@ fn quantize(hist: &mut [f32], out: &mut [u8]) {
     hist.iter_mut().for_each(|v| *v = (*v / norm).min(CLAMP));
     let norm = hist.iter().map(|v| v * v).sum::<f32>().sqrt();
     for (o, v) in out.iter_mut().zip(hist.iter()) {
+        // The u8 scale of OpenCV's and Hess's SIFT (`SIFT_INT_DESCR_FCTR`), which clamp at the
+        // same 0.2.
         *o = round_to_u8(v / norm * 512.0);
     }
 }

@@ -200,6 +200,8 @@ impl ImageBounds {
     fn of(camera: &CameraIntrinsics, width: u32, height: u32) -> Self {
         let (w, h) = (f64::from(width) - 1.0, f64::from(height) - 1.0);
         let mut x = [f64::INFINITY, f64::NEG_INFINITY];
+        // Points along each side, not just the corners: lens distortion bends the border, so
+        // its extreme columns need not be at a corner.
         for k in 0..=8 {
             let t = f64::from(k) / 8.0;
             for (u, v) in [(t * w, 0.0), (t * w, h), (0.0, t * h), (w, t * h)] {
@@ -226,7 +228,8 @@ fn rows(
     for pose in poses {
         let far = pose.rotation * ray;
         if far.z <= 0.0 {
-            // The far end of the ray is behind the right camera: no bound from this pose.
+            // The far end of the ray is behind the right camera: no bound from this pose, a
+            // million rows each side, far beyond any frame's (`stereocal_hdl::regs::MAX_HEIGHT`).
             return Some([f64::NEG_INFINITY, f64::INFINITY].map(|r| r.clamp(-1e6, 1e6)));
         }
         let t = pose.translation;
@@ -242,6 +245,8 @@ fn rows(
         let Some([s0, s1]) = clip(p, dir, s_end, bounds.x) else {
             continue;
         };
+        // The segment is straight in calibrated coordinates; the middle as well as the ends,
+        // for the bend the right camera's distortion gives its image.
         for s in [s0, 0.5 * (s0 + s1), s1] {
             let (px, py) = (p[0] + s * dir[0], p[1] + s * dir[1]);
             let row = calib.right.project(px, py).1;

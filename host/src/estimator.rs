@@ -63,7 +63,9 @@ pub struct EstimatorConfig {
     pub subpixel: Option<SubpixelConfig>,
     /// RANSAC start (its `threshold` is replaced by `ransac_threshold_px` / focal length).
     pub ransac: Option<RansacConfig>,
-    /// RANSAC inlier threshold in pixels.
+    /// RANSAC inlier threshold in pixels: localisation noise is a matter of pixels, so it
+    /// enters the fit divided by the focal length and holds for any camera (README, "Geometry,
+    /// not pixel constants").
     pub ransac_threshold_px: f64,
     /// The robust refinement that gives the estimate and its uncertainty.
     pub refine: RefineConfig,
@@ -92,7 +94,8 @@ pub struct EstimatorConfig {
 /// lower the noise of the verge estimate roughly as 1/√N.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GuidedConfig {
-    /// Matched neighbours whose median disparity predicts the position.
+    /// Matched neighbours whose median disparity predicts the position (the default's five:
+    /// with up to two of them false, their median stays within the true ones' disparities).
     pub neighbours: usize,
     /// Horizontal search range around the prediction (pixels).
     pub search_px: i32,

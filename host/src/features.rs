@@ -10,8 +10,9 @@
 //! Orientation is the fabric's 6-bit CORDIC angle: `k · 360/64°` measured from +x toward +y
 //! (image down), i.e. `atan2(gy, gx)`; magnitude is the fabric's 8-bit `x_n·5/8`.
 
-/// Side length of the gradient window the descriptor is built from.
-pub const PATCH_SIZE: usize = 16;
+/// Side length of the gradient window the descriptor is built from: the thesis' 16x16 window
+/// (4.4.2, after Lowe), which is also what a `SobelPatch` carries.
+pub const PATCH_SIZE: usize = stereocal_wire::PATCH_SIZE;
 /// Number of orientation codes of the fabric (6 bits).
 pub const ORIENTATION_STEPS: u8 = 64;
 

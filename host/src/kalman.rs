@@ -75,12 +75,17 @@ impl Default for KalmanConfig {
             turning_noise: 100.0,
             mode_time_s: 2.0,
             min_measurement_sigma_deg: 0.01,
+            // Above the 3-4 σ frames that the per-frame errors' heavy tails give every few
+            // dozen frames (module doc): those are weighed by the models, not restarted from.
             gate_sigmas: 5.0,
             initial_rate_sigma: 10.0,
             // The output's resolution (hundredths of a degree): a head whose joint angles are
             // worse than that (backlash, a commanded angle not yet reached) still predicts a
             // move to within a few of its σ, and the measurements correct the rest.
             encoder_sigma_deg: 0.01,
+            // Tails heavy enough that a 4 σ frame inside the gate leaves a still head's turning
+            // probability below one half, where a Gaussian makes it over 0.8
+            // (`one_outlying_frame_does_not_switch_a_still_head_to_turning`).
             likelihood_dof: 8.0,
         }
     }
@@ -271,6 +276,7 @@ impl VergeFilter {
         let switch = if self.config.mode_time_s > 0.0 {
             1.0 - (-dt / self.config.mode_time_s).exp()
         } else {
+            // A mode that lasts no time says nothing of the next: either is equally likely.
             0.5
         };
         let stay = 1.0 - switch;

@@ -20,7 +20,8 @@ use crate::features::Keypoint;
 /// Matching settings; the default is the most accurate for a verge head.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MatchConfig {
-    /// Lowe's ratio: best distance < ratio · second-best distance (thesis: 0.6).
+    /// Lowe's ratio: best distance < ratio · second-best distance (thesis 4.4.3: 0.6, stricter
+    /// than Lowe's 0.8 because the calibration must see as few false matches as possible).
     pub ratio: f32,
     /// Require the match to be mutual (left's best is right's best).
     pub cross_check: bool,

@@ -36,14 +36,19 @@ pub struct RansacConfig {
     /// Seed of the ChaCha RNG: the same input and seed give the same result.
     pub seed: u64,
     /// Hypotheses whose |alpha| exceeds this (radians) are discarded: a head cannot turn its
-    /// cameras sideways, and near-degenerate samples produce such solutions.
+    /// cameras sideways, and near-degenerate samples produce such solutions. The default lies
+    /// beyond the head's whole range ([`crate::epipolar_band::MAX_ANGLE_DEG`]).
     pub max_abs_angle: f64,
 }
 
 impl Default for RansacConfig {
     fn default() -> Self {
         Self {
+            // One pixel at a 700 px focal length; `VergeEstimator` replaces it with its
+            // `ransac_threshold_px` over the calibration's focal length.
             threshold: 1.0 / 700.0,
+            // Enough for `confidence` down to an inlier fraction of about 12 %:
+            // ln(1 - 0.999) / ln(1 - 0.12²) ≈ 477 two-match samples.
             max_iterations: 500,
             confidence: 0.999,
             seed: 0x5eed,
@@ -85,6 +90,8 @@ pub(crate) fn minimal_solutions(c0: &Correspondence, c1: &Correspondence) -> hea
     // q = (sin, cos) = cos·(t, 1) with t = tan a_l:  s00 t² + 2 s01 t + s11 = 0.
     let (qa, qb, qc) = (s[(0, 0)], 2.0 * s[(0, 1)], s[(1, 1)]);
     let disc = qb * qb - 4.0 * qa * qc;
+    // A leading coefficient this small (k / qa overflows, or lands at alpha_l = ±90°) marks a
+    // degenerate sample: it gives no hypothesis.
     if disc.is_nan() || disc < 0.0 || qa.abs() < 1e-300 {
         return out;
     }
@@ -188,6 +195,9 @@ pub fn ransac(
                     config.max_iterations
                 } else {
                     let k = (1.0 - config.confidence).ln() / (1.0 - p_good).ln();
+                    // A floor of samples: with nearly every match an inlier one sample would
+                    // do, but the score is MSAC's summed error, which later all-inlier samples
+                    // can still lower.
                     (k.ceil() as usize).max(8)
                 };
             }

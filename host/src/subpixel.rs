@@ -42,6 +42,8 @@ pub struct SubpixelConfig {
 impl Default for SubpixelConfig {
     fn default() -> Self {
         Self {
+            // A 15x15 window, the largest whose sums in `ncc_scan` stay exact in `f32`
+            // (225 · 255² < 2^24 < 289 · 255²).
             half_window: 7,
             max_iterations: 12,
             max_shift_px: 2.0,
@@ -365,6 +367,11 @@ fn refine_in(
     }
     let [hxx, hxy, hyy] = lane_sums([&*p0, &*p1, &*p2]);
     let det = hxx * hyy - hxy * hxy;
+    // Only a guard of the solve against a singular structure tensor (a flat window, or one of
+    // a single edge direction): det / trace² is about its small eigenvalue over its large one,
+    // and 1e-6 of trace² is at least thirty times f32's rounding of det (ε · hxx · hyy, at most
+    // ε · trace² / 4). Whether the vertical structure suffices is `max_sigma_v_px`'s to judge,
+    // at the solution.
     if det.is_nan() || det <= 1e-6 * (hxx + hyy).powi(2) || t_norm <= 0.0 {
         return None;
     }
@@ -398,6 +405,8 @@ fn refine_in(
         {
             return None;
         }
+        // A step under a thousandth of a pixel: well below the few hundredths the u8
+        // magnitudes resolve.
         if dx * dx + dy * dy < 1e-6 {
             converged = true;
             break;
@@ -423,6 +432,8 @@ fn refine_in(
     }
     let [dot, sse] = lane_sums([&*p0, &*p1]);
     let ncc = dot / (t_norm * t_norm);
+    // The residual's degrees of freedom: `n` samples less the four fitted parameters (the
+    // two of the translation, the gain and the offset).
     let noise_var = sse / (n as f32 - 4.0);
     let sigma_v = (noise_var * hxx / det).sqrt();
     if ncc < config.min_correlation || sigma_v > config.max_sigma_v_px {
@@ -580,6 +591,7 @@ pub fn guided_pair(
             (i == 0 || scores[i - 1].1 < v) && (i + 1 == scores.len() || scores[i + 1].1 <= v)
         })
         .map(|i| scores[i].1)
+        // The lowest correlation there is: no other peak.
         .fold(-1.0f32, f32::max);
     if best < config.min_correlation || runner_up > best - GUIDED_PEAK_MARGIN {
         return None;

@@ -77,6 +77,10 @@ pub(crate) fn design_row(c: &Correspondence) -> [f64; 4] {
 /// Minimum number of matches for the linear 4-unknown solve (3 equations fix a direction in R⁴).
 pub const LINEAR_MIN_MATCHES: usize = 3;
 
+/// Minimum number of matches for a refinement of the two yaws (one equation each for two
+/// unknowns).
+pub const YAW_MIN_MATCHES: usize = 2;
+
 /// Linear solve of e1..e4 (thesis 4.5.1): the right singular vector of the N×4 design matrix
 /// with the smallest singular value (computed through the 4×4 normal matrix, which has the same
 /// singular vectors), projected to a valid essential matrix and sign-resolved.
@@ -240,10 +244,10 @@ pub fn refine(
     init: VergeAngles,
     config: &RefineConfig,
 ) -> Result<ConstrainedFit, EssentialError> {
-    if matches.len() < 2 {
+    if matches.len() < YAW_MIN_MATCHES {
         return Err(EssentialError::TooFewMatches {
             got: matches.len(),
-            need: 2,
+            need: YAW_MIN_MATCHES,
         });
     }
     let mut angles = init;

@@ -112,6 +112,9 @@ impl RelativePose {
 }
 
 fn tangent_basis(t: &Unit<Vector3<f64>>) -> (Vector3<f64>, Vector3<f64>) {
+    // Any helper far from parallel to `t` will do: with |t_y| < 0.9 the cross product with y
+    // keeps at least sin(acos 0.9) ≈ 0.44 of unit length. A head's baseline lies near x, so y
+    // is the helper but for baselines that point almost straight up or down.
     let helper = if t[1].abs() < 0.9 {
         Vector3::y()
     } else {

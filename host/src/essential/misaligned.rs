@@ -12,7 +12,7 @@
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
-use super::constrained::VergeAngles;
+use super::constrained::{VergeAngles, YAW_MIN_MATCHES};
 use super::{mad_sigma, rot_x, rot_y, rot_z, skew, Correspondence, EssentialError, RefineConfig};
 use crate::calib::Extrinsics;
 
@@ -142,10 +142,10 @@ pub fn refine_yaws(
     m: &Misalignment,
     config: &RefineConfig,
 ) -> Result<YawFit, EssentialError> {
-    if matches.len() < 2 {
+    if matches.len() < YAW_MIN_MATCHES {
         return Err(EssentialError::TooFewMatches {
             got: matches.len(),
-            need: 2,
+            need: YAW_MIN_MATCHES,
         });
     }
     let mut angles = init;
