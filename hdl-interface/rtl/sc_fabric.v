@@ -1,7 +1,13 @@
 // sc_fabric: the fabric of one camera channel, behind its AXI4-lite slave: the generated
 // register block (sc_regs), the 4-octave datapath (sc_frontend), the point FIFO (512 entries)
 // and the Sobel FIFO (3 x W0 entries, as the model's OutputFifos), the frame control and the
-// counters of the register map (hdl-interface/regmap.toml, version 2).
+// counters of the register map (hdl-interface/regmap.toml, version 2.2), and the stream
+// engine (sc_stream, docs/STREAM_ENGINE.md) sending the frame's packets on LINK_OUT.
+//
+// Clocks: the datapath advances only on clocks where `pix_ce` is 1 (the camera's pixel
+// clock as an enable of the fabric's clock); the registers, the FIFOs' pops and the engine
+// work on every clock. With `pix_ce` always 1 every clock is a pixel clock, the contract the
+// device model's FabricDevice::clock keeps.
 //
 // Bus: sc_regs' simple synchronous bus (bus_we / bus_re one-clock strobes, registered
 // bus_rdata); a standard AXI4-lite front end drives it and `rst` (from !ARESETN).
@@ -25,7 +31,13 @@
 //   pixel is one `clock(Some(p))` of the model; every other clock is `clock(None)`.
 // - After the last pixel PIXEL_IN is not ready until sc_frontend's `done` (every configured
 //   octave has emitted everything into the FIFOs): BUSY falls, STATUS.FRAME_DONE is set and
-//   FRAME_COUNT counts the frame.
+//   FRAME_COUNT counts the frame. With STREAM_CONTROL.ENABLE latched at FRAME_ARM that
+//   happens when the stream engine has sent FrameEnd (state S_SEND until then).
+// - Stream engine: the clock that feeds a line's last pixel, and every WIDTH pixel clocks of
+//   the flush after it, end a line time; on the next clock both FIFOs are marked and their
+//   entries are the engine's next snapshot (sc_out_fifo's owed entries); `done` marks the
+//   last one. While the engine sends a frame the FIFOs are its own: POINT_FIFO_DATA and
+//   SOBEL_FIFO_DATA read 0 and pop nothing.
 // - SOFT_RESET empties both FIFOs, returns to idle, restarts sc_frontend (clearing its valid
 //   bits), clears the STATUS flags, the overflow counters, FRAME_COUNT, LATENCY_CLOCKS and the
 //   holding registers. Configuration registers keep their values. On the strobe's clock the

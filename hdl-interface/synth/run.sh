@@ -38,7 +38,7 @@ for tool in yosys nextpnr-ice40 python3 timeout; do
     command -v "$tool" >/dev/null || { echo "run.sh: $tool not found" >&2; exit 1; }
 done
 
-# name | top module | parameters | nextpnr devices ("-" = none) | what it is
+# name | top module | parameters | nextpnr devices ("-" = none; "xc7" = 7 Series only) | what it is
 # The first two are the report's subject; the others are the blocks of one octave, placed and
 # routed on their own for an Fmax figure where the octave does not fit an iCE40.
 JOBS=(
@@ -53,6 +53,7 @@ JOBS=(
   "refine|sc_refine||up5k hx8k|sub-pixel refinement (combinational, registered I/O)"
   "sobel|sc_sobel||up5k hx8k|3x3 Sobel (combinational, registered I/O)"
   "cordic|sc_cordic||up5k hx8k|CORDIC magnitude/orientation pipeline"
+  "stream|sc_stream|W0=640|xc7|the stream engine: snapshot queue, 68-row ring, stash, patch queue, batch, packet former, framer; 640 px rows"
 )
 
 if [ -z "${SYNTH_ONLY:-}" ]; then
@@ -62,10 +63,17 @@ mkdir -p "$OUT"
 STATUS=$OUT/status.tsv
 [ -f "$STATUS" ] || printf 'job\tstep\tstatus\tseconds\tdetail\n' > "$STATUS"
 T0=$(date +%s)
-date -u +%Y-%m-%dT%H:%M:%SZ > "$OUT/started"
-cut -d' ' -f1-3 /proc/loadavg > "$OUT/load_start" 2>/dev/null
-git -C "$REPO" rev-parse --short HEAD > "$OUT/rtl_commit" 2>/dev/null
-git -C "$REPO" status --porcelain -- hdl-interface/rtl > "$OUT/rtl_dirty" 2>/dev/null
+if [ -z "${SYNTH_ONLY:-}" ] || [ ! -f "$OUT/started" ]; then
+    date -u +%Y-%m-%dT%H:%M:%SZ > "$OUT/started"
+    cut -d' ' -f1-3 /proc/loadavg > "$OUT/load_start" 2>/dev/null
+    git -C "$REPO" rev-parse --short HEAD > "$OUT/rtl_commit" 2>/dev/null
+    git -C "$REPO" status --porcelain -- hdl-interface/rtl > "$OUT/rtl_dirty" 2>/dev/null
+    RERUN=
+else
+    # A subset on top of an earlier run: its jobs' results replace theirs, and the report
+    # says which jobs were re-run when, from which RTL.
+    RERUN="$(date -u +%Y-%m-%dT%H:%M:%SZ) $(git -C "$REPO" rev-parse --short HEAD 2>/dev/null) $SYNTH_ONLY"
+fi
 
 # status JOB STEP STATUS SECONDS DETAIL (one line, appended atomically enough for 2 writers)
 status() { printf '%s\t%s\t%s\t%s\t%s\n' "$1" "$2" "$3" "$4" "$5" >> "$STATUS"; }
@@ -140,9 +148,9 @@ do_job() {
     [ -n "$params" ] && cp="chparam $(chparams "$params") $top;"
     local rd="read_verilog -defer $files;"
 
-    # Xilinx 7-series (octave and front end; the blocks only go to the iCE40): hierarchy kept,
-    # so the report can break the totals down per block.
-    if [ "$name" = octave0 ] || [ "$name" = frontend ]; then
+    # Xilinx 7-series (octave, front end and stream engine; the blocks only go to the iCE40):
+    # hierarchy kept, so the report can break the totals down per block.
+    if [ "$name" = octave0 ] || [ "$name" = frontend ] || [ "$devs" = xc7 ]; then
         run_step "$name" xc7 "$SYNTH_TIMEOUT" "$d/xc7.log" \
             yosys -q -l "$d/xc7.log" -p "$rd $cp synth_xilinx -family xc7 -noiopad -top $top; tee -q -o $d/xc7.stat.json stat -json"
     fi
@@ -152,6 +160,15 @@ do_job() {
     if [ "$name" = octave0 ]; then
         run_step "$name" xc2v "$SYNTH_TIMEOUT" "$d/xc2v.log" \
             yosys -q -l "$d/xc2v.log" -p "$rd $cp synth_xilinx -family xc2v -noiopad -top $top; tee -q -o $d/xc2v.stat.json stat -json"
+    fi
+
+    # The stream engine's memories (its row ring alone is 609 Kbit at 640 px) fit no iCE40's
+    # block RAM, and its framer's packet memory is read combinationally: yosys maps them to
+    # logic cells there and does not finish in SYNTH_TIMEOUT. The framer is reported inside
+    # the engine.
+    if [ "$devs" = xc7 ]; then
+        status "$name" ice40 skipped 0 "memories beyond any iCE40's block RAM: 7 Series only"
+        return
     fi
 
     # iCE40 (UltraPlus primitives, SB_MAC16 allowed). With a place-and-route device the module
@@ -205,8 +222,12 @@ echo "run.sh: ${#sel[@]} jobs, $PAR in parallel, logs in $OUT"
 printf '%s\0' "${sel[@]}" | xargs -0 -P "$PAR" -I{} bash -c 'do_job "$1"; exit 0' _ {}
 
 T1=$(date +%s)
-echo $(( T1 - T0 )) > "$OUT/seconds"
-cut -d' ' -f1-3 /proc/loadavg > "$OUT/load_end" 2>/dev/null
+if [ -n "$RERUN" ]; then
+    echo "$RERUN $(( T1 - T0 ))" >> "$OUT/reruns"
+else
+    echo $(( T1 - T0 )) > "$OUT/seconds"
+    cut -d' ' -f1-3 /proc/loadavg > "$OUT/load_end" 2>/dev/null
+fi
 echo "run.sh: done in $(( T1 - T0 )) s"
 column -t -s $'\t' "$STATUS" | cut -c1-160
 
