@@ -48,9 +48,9 @@ pub const FLAG_REGISTER_MODEL: u16 = 1 << 1;
 /// to it.
 pub const FLAG_COUNT_INSTRUCTIONS: u16 = 1 << 2;
 /// The board is the SoC in the loop with its cameras wired to the fabric
-/// (`hdl-interface/soc/`): the channels drive the real fabric at MMIO
-/// ([`super::wired`]) and the images here are what the cameras send, not what the driver
-/// offers.
+/// (`hdl-interface/soc/`): the channels drive the real fabric at MMIO (`softcore::wired`,
+/// built for the soft-core only) and the images here are what the cameras send, not what the
+/// driver offers.
 pub const FLAG_WIRED_CAMERAS: u16 = 1 << 3;
 const KNOWN_FLAGS: u16 =
     FLAG_AUTOSTART | FLAG_REGISTER_MODEL | FLAG_COUNT_INSTRUCTIONS | FLAG_WIRED_CAMERAS;
