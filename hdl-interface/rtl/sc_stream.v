@@ -122,7 +122,11 @@ module sc_stream #(
     reg [31:0] drops_p0, drops_s0;       // the FIFOs' drops at FRAME_ARM
     reg        sending;                  // FRAME_ARM .. FrameEnd (or the fault's end)
     reg        faulted;
-    wire [7:0] source = (camera == 8'hFF) ? 8'hFF : camera + 8'd1;
+    // The wire source of camera `c` (1 + c; camera 255 shares 255 with camera 254).
+    function [7:0] source_of(input [7:0] c);
+        source_of = (c == 8'hFF) ? 8'hFF : c + 8'd1;
+    endfunction
+    wire [7:0] source = source_of(camera);
     reg [7:0]  seq_source;               // the source the numbering counts
     reg [15:0] seq;
 
@@ -378,11 +382,11 @@ module sc_stream #(
                       || px_y < next_row[co];
 
     // Octave dims: ceil(n / 2^k).
-    function [15:0] cdiv(input [15:0] n, input [1:0] k);
+    function [15:0] cdiv(input [15:0] n, input [1:0] sh);
         reg [15:0] m;
         begin
-            m = (16'd1 << k) - 16'd1;
-            cdiv = (n >> k) + {15'd0, (n & m) != 16'd0};
+            m = (16'd1 << sh) - 16'd1;
+            cdiv = (n >> sh) + {15'd0, (n & m) != 16'd0};
         end
     endfunction
 
@@ -402,11 +406,9 @@ module sc_stream #(
         sat_inc = (v == 32'hFFFF_FFFF) ? v : v + 32'd1;
     endfunction
 
-    integer i;
-    always @(posedge clk) begin
-        if (abort) begin
-            st <= E_IDLE;
-            sending <= 1'b0;
+    // What FRAME_ARM and an abort both zero: the fault, the counters, the snapshot queue.
+    task clear_frame;
+        begin
             faulted <= 1'b0;
             sq_n <= 0;
             sq_rd <= 0;
@@ -419,6 +421,15 @@ module sc_stream #(
             fault_x <= 11'd0;
             fault_y <= 11'd0;
             fault_overrun <= 1'b0;
+        end
+    endtask
+
+    integer i;
+    always @(posedge clk) begin
+        if (abort) begin
+            st <= E_IDLE;
+            sending <= 1'b0;
+            clear_frame();
             if (rst) begin
                 seq <= 16'd0;
                 seq_source <= 8'd1;
@@ -467,23 +478,12 @@ module sc_stream #(
                 timestamp <= cfg_timestamp;
                 drops_p0 <= drops_points;
                 drops_s0 <= drops_sobel;
-                if (((cfg_camera == 8'hFF) ? 8'hFF : cfg_camera + 8'd1) != seq_source) begin
-                    seq_source <= (cfg_camera == 8'hFF) ? 8'hFF : cfg_camera + 8'd1;
+                if (source_of(cfg_camera) != seq_source) begin
+                    seq_source <= source_of(cfg_camera);
                     seq <= 16'd0;
                 end
                 sending <= 1'b1;
-                faulted <= 1'b0;
-                count_points <= 32'd0;
-                count_sobel <= 32'd0;
-                count_dropped <= 32'd0;
-                fault_cause <= 2'd0;
-                fault_octave <= 2'd0;
-                fault_x <= 11'd0;
-                fault_y <= 11'd0;
-                fault_overrun <= 1'b0;
-                sq_n <= 0;
-                sq_rd <= 0;
-                sq_wr <= 0;
+                clear_frame();
                 snap_is_final <= 1'b0;
                 final_seen <= 1'b0;
                 q_n <= 0;
