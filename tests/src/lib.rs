@@ -41,8 +41,9 @@ use stereocal::output::record::FrameRecord;
 use stereocal::session::{Session, SessionConfig, SessionError};
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
 use stereocal_tools::eval::{fabric_size, sequence_calibration};
-use stereocal_tools::hil::{run_on_qemu, HilError, QemuConfig, QemuRun, DEFAULT_QEMU};
-use stereocal_wire::{decode, Capabilities, PacketRepr, DELIMITER};
+use stereocal_tools::hil::{
+    compare_streams, run_on_qemu, HilError, QemuConfig, QemuRun, QemuTimeouts, DEFAULT_QEMU,
+};
 
 /// One stereo pair.
 #[derive(Debug, Clone)]
@@ -183,51 +184,11 @@ pub fn run_qemu(
 }
 
 /// Asserts that the firmware's UART bytes are the in-process device's bytes: the same
-/// `Hello` but for the `LOG` capability, then every byte the same.
-pub fn assert_same_stream(name: &str, qemu: &[u8], in_process: &[u8]) {
-    let (q_hello, q_rest) = split_first_frame(name, "QEMU", qemu);
-    let (i_hello, i_rest) = split_first_frame(name, "in-process", in_process);
-    let hello = |frame: &[u8], who: &str| {
-        let mut frame = frame.to_vec();
-        match decode(&mut frame) {
-            Ok((header, PacketRepr::Hello(hello))) => (header.seq, hello),
-            other => panic!("{name}: {who}: first packet is not a Hello: {other:?}"),
-        }
-    };
-    let (q_seq, q) = hello(q_hello, "QEMU");
-    let (i_seq, i) = hello(i_hello, "in-process");
-    assert_eq!(
-        (q_seq, q.version),
-        (i_seq, i.version),
-        "{name}: Hello header"
-    );
-    assert_eq!(
-        q.capabilities,
-        i.capabilities | Capabilities::LOG,
-        "{name}: the firmware's capabilities are the in-process device's plus LOG"
-    );
-    if q_rest != i_rest {
-        let at = q_rest
-            .iter()
-            .zip(i_rest)
-            .position(|(a, b)| a != b)
-            .unwrap_or(q_rest.len().min(i_rest.len()));
-        let frame = q_rest[..at].iter().filter(|&&b| b == DELIMITER).count();
-        panic!(
-            "{name}: the streams differ after the Hello at byte {at} (link frame {frame}): \
-             QEMU sent {} bytes, in-process {}",
-            q_rest.len(),
-            i_rest.len()
-        );
+/// `Hello` but for the `LOG` capability, then every byte the same ([`compare_streams`]).
+pub fn assert_same_stream(name: &str, device: &[u8], in_process: &[u8]) {
+    if let Err(e) = compare_streams(device, in_process) {
+        panic!("{name}: {e}");
     }
-}
-
-fn split_first_frame<'a>(name: &str, who: &str, bytes: &'a [u8]) -> (&'a [u8], &'a [u8]) {
-    let end = bytes
-        .iter()
-        .position(|&b| b == DELIMITER)
-        .unwrap_or_else(|| panic!("{name}: {who} sent no complete link frame"));
-    bytes.split_at(end + 1)
 }
 
 /// Whether the runs gave the same records, field by field (floats exactly).
@@ -272,6 +233,7 @@ pub fn soc_or_skip(test: &str) -> Option<QemuConfig> {
     };
     firmware_elf_or_skip(test).map(|elf| QemuConfig {
         soc: Some(sim),
+        timeouts: QemuTimeouts::soc(),
         ..QemuConfig::new(elf)
     })
 }

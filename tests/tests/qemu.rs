@@ -137,9 +137,18 @@ fn qemu_hil_summary_equals_eval_summary() {
     let eval = summary(&records, cost.wire_bytes_per_pair());
     let run = run_sequence(&qemu, &sequence, config, &mut |_| {})
         .unwrap_or_else(|e| panic!("{test}: {e}"));
-    let (hil_records, hil_cost) = &run.value;
+    let (hil_records, hil_cost) = &run.device.value;
     let hil = summary(hil_records, hil_cost.wire_bytes_per_pair());
     assert_eq!(hil, eval);
+    assert_eq!(
+        run.wire,
+        Some(Ok(())),
+        "{test}: the bytes are the in-process device's"
+    );
+    assert!(
+        run.records_identical,
+        "{test}: the records are the in-process device's"
+    );
     assert_eq!(hil.estimated_frames, 3, "{hil:?}");
     eprintln!("{test}: equal summaries: {hil:?}");
 }

@@ -17,7 +17,8 @@
 //!    (`softcore::instructions`), preceded by the main loop's stack high-water mark
 //!    (`softcore::stack`: the free stack is painted as soon as the input says to count).
 //! 4. Exit through the `sifive_test` finisher: 0 when every frame ran, 2 for a bad input
-//!    region, 3 when a frame failed (an `ErrorReport` says why), 101 on a panic.
+//!    region, 3 when a frame failed (an `ErrorReport` says why), 4 on a trap
+//!    (`softcore::trap`), 101 on a panic.
 //!
 //! Build: `cargo build --release -p stereocal-firmware --target riscv32imc-unknown-none-elf`.
 //! Run: see the `softcore` module of the library (QEMU command line, link protocol). On any other target this file builds a stub that says so,
@@ -47,6 +48,7 @@ mod soft_core {
     };
     use stereocal_firmware::softcore::instructions::{self, CountedFabric, InstructionReport};
     use stereocal_firmware::softcore::link::{Uart0, LINK};
+    use stereocal_firmware::softcore::soc::ImageReport;
     use stereocal_firmware::softcore::stack::{self, StackReport};
     use stereocal_firmware::softcore::wired::{ChannelFabric, ModelFabric, WiredFabric};
     use stereocal_hdl::regs::{control, height, width};
@@ -229,6 +231,7 @@ mod soft_core {
     fn run<F: ChannelFabric>(input: &FrameInput<'_>, mut channels: [Channel<F>; 2]) -> ! {
         let header = *input.header();
         let measure_stack = header.has_flag(FLAG_COUNT_INSTRUCTIONS);
+        let wired = header.has_flag(FLAG_WIRED_CAMERAS);
         // Boot is the deepest the stack goes (the channels are built by value); paint again
         // so that the mark after the frames is the main loop's own.
         let (boot_stack, _) = stack::high_water();
@@ -256,9 +259,26 @@ mod soft_core {
                 channel.bus().take_counted();
                 channel.bus_mut().take_link_waited();
                 with_link(|link| link.sink_mut().take_waited());
+                channel.bus_mut().take_wait_cycles();
                 let start = instructions::instret();
+                let start_cycle = riscv::register::mcycle::read64();
                 let result = channel.process_frame(image.pixels, image.timestamp_us);
                 let spent = instructions::instret().wrapping_sub(start);
+                let cycles = riscv::register::mcycle::read64().wrapping_sub(start_cycle);
+                if let (Ok(summary), true) = (&result, wired) {
+                    let report = ImageReport {
+                        frame: summary.frame_id,
+                        camera: camera as u8,
+                        softcore_cycles: u32::try_from(
+                            cycles.wrapping_sub(channel.bus_mut().take_wait_cycles()),
+                        )
+                        .unwrap_or(u32::MAX),
+                        point_overflows: summary.overflow.points,
+                        sobel_overflows: summary.overflow.sobel,
+                    };
+                    // SAFETY: `wired`: the board is the SoC in the loop, which has the port.
+                    unsafe { report.write() };
+                }
                 // The stream engine's waits for the transmitter are inside the fabric's count.
                 let link_wait = channel.bus_mut().take_link_waited();
                 match result {

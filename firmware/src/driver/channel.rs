@@ -287,6 +287,9 @@ fn stream_fault(word: u32) -> Result<(), DriverError> {
     let octave = stream_fault::OCTAVE.extract(word) as u8;
     let x = stream_fault::X.extract(word) as u16;
     let y = stream_fault::Y.extract(word) as u16;
+    if stream_fault::OVERRUN.extract(word) != 0 {
+        return Err(DriverError::StreamOverrun { octave, y });
+    }
     match Cause::from_bits(stream_fault::CAUSE.extract(word)) {
         Some(Cause::None) | None => Ok(()),
         Some(Cause::SobelOrder) => Err(DriverError::SobelOutOfOrder(OutOfOrder { octave, x, y })),

@@ -26,6 +26,8 @@ pub enum ExitCode {
     BadInput = 2,
     /// At least one frame could not be processed (an `ErrorReport` on the link says why).
     FrameFailed = 3,
+    /// The core took an exception (a bug, or a bus error on the board): a log said which.
+    Trap = 4,
 }
 
 impl ExitCode {

@@ -48,12 +48,9 @@ pub struct InstructionReport {
 }
 
 /// The numbers of a report line `PREFIX name value name value ...`, in `names` order;
-/// `None` unless the line is exactly that.
-pub(crate) fn fields<const N: usize>(
-    text: &str,
-    prefix: &str,
-    names: [&str; N],
-) -> Option<[u64; N]> {
+/// `None` unless the line is exactly that. Every report of the soft-core and of the SoC
+/// board (`softcore::soc`) has this form, so one reader serves them all.
+pub fn fields<const N: usize>(text: &str, prefix: &str, names: [&str; N]) -> Option<[u64; N]> {
     let mut words = text.split_whitespace();
     if words.next()? != prefix {
         return None;

@@ -25,8 +25,8 @@
 //! starts at once (a host that asked first gets exactly one `Hello`, as from the in-process
 //! device, so the two byte streams stay comparable). Then it sends every frame's packets and
 //! exits: status 0 when every frame ran, 2 for a bad input region (after a `Hello` and a log
-//! saying why), 3 when a frame failed (an `ErrorReport` said why), 101 on a panic (a defmt `Log`
-//! packet carries the message). The host may send more packets between frames; they are read
+//! saying why), 3 when a frame failed (an `ErrorReport` said why), 4 on a trap and 101 on a panic (a defmt
+//! `Log` packet carries what trapped or the panic message). The host may send more packets between frames; they are read
 //! when the current frame is done (QEMU holds them back meanwhile; a real UART would need the
 //! host to wait for `FrameEnd`).
 //!
@@ -38,6 +38,7 @@
 pub mod finisher;
 pub mod frame_input;
 pub mod instructions;
+pub mod soc;
 pub mod stack;
 pub mod uart;
 
@@ -47,6 +48,8 @@ pub mod link;
 mod logger;
 #[cfg(target_os = "none")]
 pub mod panic;
+#[cfg(target_os = "none")]
+pub mod trap;
 #[cfg(target_os = "none")]
 pub mod wired;
 

@@ -10,10 +10,7 @@ use stereocal_hdl::{Mmio, PixelIn, RegisterBus};
 use crate::fabric::{FabricDevice, FabricModel};
 use crate::softcore::instructions::CountedFabric;
 use crate::softcore::link::Uart0;
-
-/// Where camera `c`'s `sc_fabric` sits on the SoC's bus (`hdl-interface/soc/sc_soc.v`):
-/// the register map's base address plus `c` times this.
-pub const CHANNEL_STRIDE: usize = 0x1_0000;
+use crate::softcore::soc::CHANNEL_STRIDE;
 
 /// Core clocks a camera's pixel clock may last on the SoC: what the driver's waits for the
 /// camera allow per pixel clock. The SoC harness runs the cameras at one pixel clock in 64
@@ -26,9 +23,12 @@ pub const MAX_CORE_CLOCKS_PER_PIXEL: u64 = 4096;
 /// the frame itself once the fabric is armed. `push` returns at once; `idle(clocks)` waits
 /// until the fabric is no longer busy, for at most `clocks` pixel clocks of the slowest
 /// camera the board may have, so the driver's bound on a frame's flush still ends a frame
-/// that never ends.
+/// that never ends. The clock cycles those waits take are counted apart
+/// ([`ChannelFabric::take_wait_cycles`]): they are the camera's and the fabric's time, not
+/// the program's work.
 pub struct WiredFabric {
     mmio: Mmio,
+    waited: u64,
 }
 
 impl WiredFabric {
@@ -42,6 +42,7 @@ impl WiredFabric {
         // SAFETY: the caller's contract.
         Self {
             mmio: unsafe { Mmio::new(base) },
+            waited: 0,
         }
     }
 }
@@ -62,9 +63,11 @@ impl PixelIn for WiredFabric {
     fn idle(&mut self, clocks: u32) {
         let budget = u64::from(clocks) * MAX_CORE_CLOCKS_PER_PIXEL;
         let start = riscv::register::mcycle::read64();
-        while self.mmio.read_field(&status::BUSY) != 0
-            && riscv::register::mcycle::read64().wrapping_sub(start) < budget
-        {}
+        let mut now = start;
+        while self.mmio.read_field(&status::BUSY) != 0 && now.wrapping_sub(start) < budget {
+            now = riscv::register::mcycle::read64();
+        }
+        self.waited = self.waited.wrapping_add(now.wrapping_sub(start));
     }
 }
 
@@ -81,6 +84,10 @@ pub trait ChannelFabric: RegisterBus + PixelIn {
     /// Instructions the model's stream engine waited for the UART since the last call (0
     /// for the real fabric, whose engine has its own link).
     fn take_link_waited(&mut self) -> u64;
+
+    /// Clock cycles spent waiting for the fabric to finish a frame since the last call (0 for
+    /// the model, which does the frame inside the driver's calls).
+    fn take_wait_cycles(&mut self) -> u64;
 }
 
 impl ChannelFabric for ModelFabric {
@@ -91,6 +98,10 @@ impl ChannelFabric for ModelFabric {
     fn take_link_waited(&mut self) -> u64 {
         self.inner_mut().link_mut().take_waited()
     }
+
+    fn take_wait_cycles(&mut self) -> u64 {
+        0
+    }
 }
 
 impl ChannelFabric for WiredFabric {
@@ -100,5 +111,9 @@ impl ChannelFabric for WiredFabric {
 
     fn take_link_waited(&mut self) -> u64 {
         0
+    }
+
+    fn take_wait_cycles(&mut self) -> u64 {
+        core::mem::take(&mut self.waited)
     }
 }

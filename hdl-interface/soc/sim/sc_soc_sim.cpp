@@ -4,7 +4,8 @@
 // and spoken to as the host's QEMU link starts and speaks to QEMU:
 //
 //   sc_soc_sim --elf ELF --uart SOCKET [--load FILE@ADDR]... [--frames FILE]
-//              [--ram-mib N] [--max-cycles N] [--pixel-clock-divider N] [--line-blank N]
+//              [--ram-mib N] [--max-cycles N] [--watchdog-cycles N]
+//              [--pixel-clock-divider N] [--line-blank N]
 //
 // - RAM at 0x8000_0000 (--ram-mib, 128 as QEMU's default -m): the ELF's PT_LOAD segments and
 //   every --load file are copied in before reset (QEMU's -kernel and -device loader).
@@ -27,13 +28,25 @@
 // - The link: the UART's bytes and both LINK_OUT ports share the socket at link-frame
 //   boundaries: a source that has begun a frame keeps the socket until its 0x00 delimiter,
 //   the others' bytes wait (a link arbiter; LINK_OUT is always ready).
+// - The report port at 0x4002_0000 (firmware softcore/soc.rs): five write-only words FRAME,
+//   CAMERA, POINT_OVERFLOWS, SOBEL_OVERFLOWS, CYCLES; a write of CYCLES prints the record as
+//   `sc_soc_sim: image frame F camera C softcore_cycles N point_overflows P sobel_overflows S`.
 // - --max-cycles (default: none) ends a run that did not finish with exit status 124 and a
 //   message naming the limit; the host side reports it as a timeout.
+// - The watchdog: a run in which nothing moves for --watchdog-cycles clocks (default
+//   1,000,000; 0 turns it off) ends with exit status 124 and a message saying what stood
+//   still and where the core last fetched. Moving is a camera pixel taken or a byte on the
+//   link either way; polling registers is not (a firmware stuck waiting for a camera that
+//   never sends polls STATUS forever). A healthy run's longest stillness is printed at exit
+//   (`longest_still`), well below the default (hdl-interface/soc/README.md).
 //
 // Both buses get zero-wait-state answers: the harness acknowledges every clock on which a
 // bus holds STB, one transfer per acknowledged clock, so a register read has exactly one
-// effect. On exit it prints to stderr one line `sc_soc_sim: cycles N seconds S fabric_reads N
-// fabric_writes N`.
+// effect. On exit it prints to stderr, per camera image, `sc_soc_sim: timing camera C image I
+// first_pixel N last_pixel N first_byte N last_byte N` (clocks: the image's first and last
+// pixel taken, the first and last byte its fabric's LINK_OUT sent for it, from its FrameStart,
+// which leaves at FRAME_ARM, to its last delimiter), then one line `sc_soc_sim: cycles N millis N fabric_reads N fabric_writes N
+// longest_still N pixel_clock_divider N` (millis: the simulation's wall time).
 
 #include <elf.h>
 #include <errno.h>
@@ -60,6 +73,8 @@ namespace {
 constexpr uint32_t RAM_BASE = 0x80000000u;
 constexpr uint32_t UART_BASE = 0x10000000u;
 constexpr uint32_t FINISHER = 0x00100000u;
+constexpr uint32_t REPORT_PORT = 0x40020000u;
+constexpr uint32_t REPORT_WORDS = 5;   // FRAME, CAMERA, POINT_OVERFLOWS, SOBEL_OVERFLOWS, CYCLES
 
 [[noreturn]] void die(const std::string &what) {
     std::fprintf(stderr, "sc_soc_sim: %s\n", what.c_str());
@@ -190,6 +205,12 @@ struct Link {
     }
 };
 
+/// When an image went in and its packets came out, in clocks.
+struct Timing {
+    uint64_t first_pixel = 0, last_pixel = 0, first_byte = 0, last_byte = 0;
+    bool any_byte = false;
+};
+
 /// The images of one camera from a frame-grabber file.
 struct Camera {
     std::vector<const uint8_t *> images;
@@ -197,6 +218,48 @@ struct Camera {
     size_t at = 0;       // pixel of the current image; 0 and !sending: waiting for the trigger
     bool sending = false;
     uint64_t blank = 0;  // pixel clocks of line blanking left
+    std::vector<Timing> timing;   // one per image begun
+    // LINK_OUT's link frames: where the latest began, the byte before it, the latest byte.
+    bool in_frame = false;
+    uint64_t frame_begin = 0, byte_before_frame = 0, latest_byte = 0;
+    bool any_byte = false, byte_before = false;
+
+    /// A byte left this camera's LINK_OUT; it belongs to the image begun last.
+    void byte_out(uint64_t cycle, uint8_t byte) {
+        if (!in_frame) {
+            byte_before = any_byte;
+            byte_before_frame = latest_byte;
+            frame_begin = cycle;
+            in_frame = true;
+        }
+        if (byte == 0) in_frame = false;
+        any_byte = true;
+        latest_byte = cycle;
+        if (timing.empty()) return;
+        Timing &t = timing.back();
+        if (!t.any_byte) t.first_byte = cycle;
+        t.any_byte = true;
+        t.last_byte = cycle;
+    }
+
+    /// The image's first pixel went in, on the first pixel clock after FRAME_ARM. Every byte
+    /// of the image before left before the arm (the driver arms once BUSY fell after that
+    /// image's last delimiter, hundreds of clocks of its own work before), and the new
+    /// image's FrameStart begins at the arm: so a link frame begun within the last pixel
+    /// clock is the new image's, and the bytes before it the previous image's; otherwise
+    /// the FrameStart is still to come.
+    void image_begins(uint64_t cycle, uint64_t divider) {
+        bool started = any_byte && cycle - frame_begin <= divider;
+        if (started && !timing.empty() && byte_before) timing.back().last_byte = byte_before_frame;
+        timing.emplace_back();
+        Timing &t = timing.back();
+        t.first_pixel = cycle;
+        if (started) {
+            t.any_byte = true;
+            t.first_byte = frame_begin;
+            t.last_byte = latest_byte;
+        }
+    }
 };
 
 struct Args {
@@ -205,6 +268,7 @@ struct Args {
     std::vector<std::pair<std::string, uint32_t>> loads;
     uint64_t ram_mib = 128;
     uint64_t max_cycles = 0;
+    uint64_t watchdog = 1000000;
 };
 
 Args parse(int argc, char **argv) {
@@ -239,6 +303,8 @@ Args parse(int argc, char **argv) {
             a.ram_mib = std::strtoull(value().c_str(), nullptr, 0);
         } else if (k == "--max-cycles") {
             a.max_cycles = std::strtoull(value().c_str(), nullptr, 0);
+        } else if (k == "--watchdog-cycles") {
+            a.watchdog = std::strtoull(value().c_str(), nullptr, 0);
         } else {
             die("unknown argument " + k);
         }
@@ -290,6 +356,8 @@ int main(int argc, char **argv) {
     auto t0 = std::chrono::steady_clock::now();
     uint64_t cycle = 0;
     int exit_status = -1;
+    uint64_t last_move = 0, longest_still = 0, last_fetch = 0;
+    uint32_t report[REPORT_WORDS] = {};
 
     auto edge = [&]() {
         top.clk = 1;
@@ -307,6 +375,17 @@ int main(int argc, char **argv) {
     top.eval();
 
     while (exit_status < 0) {
+        uint64_t still = cycle - last_move;
+        if (still > longest_still) longest_still = still;
+        if (args.watchdog && still >= args.watchdog) {
+            std::fprintf(stderr, "sc_soc_sim: watchdog: nothing moved for %llu clocks (no "
+                         "camera pixel taken, no byte on the link either way) since clock "
+                         "%llu; the core last fetched at 0x%08x: the firmware hangs\n",
+                         static_cast<unsigned long long>(still),
+                         static_cast<unsigned long long>(last_move), unsigned(last_fetch));
+            exit_status = 124;
+            break;
+        }
         if (args.max_cycles && cycle >= args.max_cycles) {
             std::fprintf(stderr, "sc_soc_sim: the firmware did not finish within %llu cycles "
                          "(data bus %s at 0x%08x, instruction bus %s at 0x%08x)\n",
@@ -322,6 +401,7 @@ int main(int argc, char **argv) {
         top.ibus_err = 0;
         if (top.ibus_cyc && top.ibus_stb) {
             uint32_t addr = uint32_t(top.ibus_adr) << 2;
+            last_fetch = addr;
             if (ram.holds(addr, 4)) {
                 uint32_t w;
                 std::memcpy(&w, &ram.bytes[addr - RAM_BASE], 4);
@@ -355,12 +435,16 @@ int main(int argc, char **argv) {
                     uint32_t reg = addr - UART_BASE + b;
                     uint8_t v = 0;
                     if (top.dbus_we) {
-                        if (reg == 0) link.push(0, uint8_t(wdata >> (8 * b)));
+                        if (reg == 0) {
+                            link.push(0, uint8_t(wdata >> (8 * b)));
+                            last_move = cycle;
+                        }
                     } else if (reg == 0) {
                         if (uart.rx.empty()) uart.poll_rx();
                         if (!uart.rx.empty()) {
                             v = uart.rx.front();
                             uart.rx.pop_front();
+                            last_move = cycle;
                         }
                     } else if (reg == 5) {
                         if (uart.rx.empty()) uart.poll_rx();
@@ -378,6 +462,15 @@ int main(int argc, char **argv) {
                     else if (code == 0x3333)
                         exit_status = int(wdata >> 16);
                 }
+                top.dbus_dat_r = 0;
+                top.dbus_ack = 1;
+            } else if (addr >= REPORT_PORT && addr < REPORT_PORT + 4 * REPORT_WORDS) {
+                uint32_t word = (addr - REPORT_PORT) / 4;
+                if (top.dbus_we) report[word] = wdata;
+                if (top.dbus_we && word == REPORT_WORDS - 1)
+                    std::fprintf(stderr, "sc_soc_sim: image frame %u camera %u softcore_cycles %u "
+                                 "point_overflows %u sobel_overflows %u\n",
+                                 report[0], report[1], report[4], report[2], report[3]);
                 top.dbus_dat_r = 0;
                 top.dbus_ack = 1;
             } else {
@@ -412,7 +505,11 @@ int main(int argc, char **argv) {
         top.clk = 0;
         top.eval();
         for (int c = 0; c < 2; c++) {
-            if ((top.link_valid >> c) & 1) link.push(1 + c, uint8_t(top.link_data >> (8 * c)));
+            if ((top.link_valid >> c) & 1) {
+                link.push(1 + c, uint8_t(top.link_data >> (8 * c)));
+                cams[c].byte_out(cycle, uint8_t(top.link_data >> (8 * c)));
+                last_move = cycle;
+            }
             if (!((valid >> c) & 1)) continue;
             Camera &cam = cams[c];
             bool taken = (top.cam_ready >> c) & 1;
@@ -428,7 +525,10 @@ int main(int argc, char **argv) {
             if (!cam.sending) {
                 cam.sending = true;
                 cam.at = 0;
+                cam.image_begins(cycle, args.divider);
             }
+            cam.timing.back().last_pixel = cycle;
+            last_move = cycle;
             cam.at++;
             if (cam.at % width == 0) cam.blank = args.line_blank;
             if (cam.at == size_t(width) * height) {
@@ -442,11 +542,25 @@ int main(int argc, char **argv) {
         cycle++;
     }
 
-    double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::fprintf(stderr, "sc_soc_sim: cycles %llu seconds %.3f fabric_reads %u fabric_writes %u\n",
-                 static_cast<unsigned long long>(cycle), seconds, unsigned(top.fabric_reads),
-                 unsigned(top.fabric_writes));
+    auto millis = std::chrono::duration_cast<std::chrono::milliseconds>(
+                      std::chrono::steady_clock::now() - t0)
+                      .count();
+    for (int c = 0; c < 2; c++)
+        for (size_t i = 0; i < cams[c].timing.size(); i++) {
+            const Timing &t = cams[c].timing[i];
+            std::fprintf(stderr, "sc_soc_sim: timing camera %d image %zu first_pixel %llu "
+                         "last_pixel %llu first_byte %llu last_byte %llu\n", c, i,
+                         static_cast<unsigned long long>(t.first_pixel),
+                         static_cast<unsigned long long>(t.last_pixel),
+                         static_cast<unsigned long long>(t.first_byte),
+                         static_cast<unsigned long long>(t.last_byte));
+        }
+    std::fprintf(stderr, "sc_soc_sim: cycles %llu millis %lld fabric_reads %u fabric_writes %u "
+                 "longest_still %llu pixel_clock_divider %llu\n",
+                 static_cast<unsigned long long>(cycle), static_cast<long long>(millis),
+                 unsigned(top.fabric_reads), unsigned(top.fabric_writes),
+                 static_cast<unsigned long long>(longest_still),
+                 static_cast<unsigned long long>(args.divider));
     top.final();
     if (uart.fd >= 0) close(uart.fd);
     return exit_status;

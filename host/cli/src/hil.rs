@@ -1,7 +1,9 @@
-//! `stereocal hil`: the `eval` run with the firmware ELF on the emulated soft-core (QEMU)
-//! instead of the in-process device.
+//! `stereocal hil`: the `eval` run with the firmware ELF on the emulated soft-core (QEMU) or
+//! on the SoC in the loop (a real core and the fabric's RTL under Verilator) instead of the
+//! in-process device, then the same frames on the in-process device, whose bytes and records
+//! the run's are compared with.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
@@ -9,7 +11,8 @@ use clap::Args;
 use stereocal::output::summary::{Residual, Summary};
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
 use stereocal_tools::hil::{
-    instruction_reports, kernel_report, run_sequence, QemuConfig, QemuTimeouts, DEFAULT_QEMU,
+    instruction_reports, kernel_report, run_sequence, QemuConfig, QemuTimeouts, SequenceRun,
+    SocReport, DEFAULT_QEMU,
 };
 
 use crate::options::{EstimateArgs, SizeArgs};
@@ -41,14 +44,21 @@ pub struct HilArgs {
     #[arg(long, default_value = DEFAULT_QEMU)]
     qemu: PathBuf,
     /// Run the ELF on the SoC in the loop instead of QEMU: a real RV32IMAC core (VexRiscv)
-    /// under Verilator, the simulator `bash hdl-interface/soc/build.sh DIR` builds as
-    /// DIR/sc_soc_sim.
-    #[arg(long, value_name = "SC_SOC_SIM")]
+    /// and both channels' fabric RTL under Verilator. Without a path, the simulator
+    /// `sc-soc-sim` next to this program or on PATH (`cargo build --release -p
+    /// stereocal-hil --bin sc-soc-sim`).
+    #[arg(long, value_name = "SC_SOC_SIM", num_args = 0..=1, default_missing_value = "")]
     soc: Option<PathBuf>,
-    /// Seconds to wait for one answer or frame pair from the emulated device.
-    #[arg(long, default_value_t = QemuTimeouts::default().answer.as_secs(),
-          value_parser = clap::value_parser!(u64).range(1..=86_400))]
-    timeout: u64,
+    /// On the SoC: the cameras' pixel clock, one clock in N (the board's default is 64, the
+    /// stream engine's pace; 1 is a pixel every clock).
+    #[arg(long, requires = "soc", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pixel_clock_divider: Option<u32>,
+    /// Seconds to wait for one answer or frame pair (default: 120 under QEMU, where a run
+    /// whose link is silent for 10 s ends as hung; 3600 on the SoC, where a 640x480 pair is
+    /// minutes of simulation and the board itself ends a firmware that hangs after a million
+    /// clocks in which nothing moved).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    timeout: Option<u64>,
     /// Count instructions (QEMU: with `-icount shift=0`; the SoC's core counts them itself)
     /// and print the soft-core's instructions per pixel, and per pair its program's own
     /// (`softcore_instructions_per_pair` in `--json`).
@@ -75,18 +85,25 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
     args.size.apply(&mut config);
     let sequence = Sequence::builtin(args.scene, config)
         .with_context(|| format!("cannot build the `{}` sequence", args.scene))?;
+    let soc = args.soc.as_deref().map(soc_simulator).transpose()?;
+    let defaults = if soc.is_some() {
+        QemuTimeouts::soc()
+    } else {
+        QemuTimeouts::default()
+    };
     let qemu = QemuConfig {
         qemu: args.qemu.clone(),
         count_instructions: args.count_instructions,
-        soc: args.soc.clone(),
+        soc: soc.clone(),
+        pixel_clock_divider: args.pixel_clock_divider,
         timeouts: QemuTimeouts {
-            answer: Duration::from_secs(args.timeout),
-            ..QemuTimeouts::default()
+            answer: args.timeout.map_or(defaults.answer, Duration::from_secs),
+            ..defaults
         },
         ..QemuConfig::new(&args.elf)
     };
 
-    let machine = if args.soc.is_some() {
+    let machine = if soc.is_some() {
         "soft-core on the SoC (Verilator)"
     } else {
         "soft-core under QEMU"
@@ -99,7 +116,11 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
         &mut |_| bar.inc(1),
     );
     bar.finish_and_clear();
-    let run = run.with_context(|| format!("hardware-in-the-loop run of {}", args.elf.display()))?;
+    let SequenceRun {
+        device: run,
+        wire,
+        records_identical,
+    } = run.with_context(|| format!("hardware-in-the-loop run of {}", args.elf.display()))?;
     if args.verbose {
         if run.logs.is_empty() {
             eprintln!("firmware: no log messages");
@@ -107,8 +128,44 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
         for log in &run.logs {
             eprintln!("firmware {log}");
         }
+        if run.board.is_some() {
+            for line in run.end.stderr.lines() {
+                eprintln!("board {line}");
+            }
+        }
     }
     let mut json_extra = serde_json::Map::new();
+    match &wire {
+        Some(Ok(())) => {
+            eprintln!("wire bytes after the Hello: identical to the in-process device's")
+        }
+        Some(Err(e)) => eprintln!("wire bytes: NOT the in-process device's: {e}"),
+        None => eprintln!("wire bytes: not compared (the instruction reports are extra packets)"),
+    }
+    eprintln!(
+        "records: {} the in-process device's",
+        if records_identical {
+            "identical to"
+        } else {
+            "NOT"
+        }
+    );
+    json_extra.insert(
+        "wire_bytes_identical".into(),
+        wire.as_ref().map(Result::is_ok).into(),
+    );
+    json_extra.insert("records_identical".into(), records_identical.into());
+    eprintln!(
+        "link: longest silence {:.2} s",
+        run.end.longest_silence.as_secs_f64()
+    );
+    json_extra.insert(
+        "link_longest_silence_s".into(),
+        run.end.longest_silence.as_secs_f64().into(),
+    );
+    if let Some(board) = &run.board {
+        board_figures(board, &mut json_extra);
+    }
     if args.count_instructions {
         print_instructions(&run.logs);
         let per_pair = softcore_instructions_per_pair(&run.logs)
@@ -117,7 +174,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
         json_extra.insert("softcore_instructions_per_pair".into(), per_pair.into());
     }
     eprintln!(
-        "QEMU: {}, {} bytes from the UART",
+        "{machine}: {}, {} bytes on the link",
         run.end.exit,
         run.end.transcript.len()
     );
@@ -126,7 +183,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
     let (w, h) = sequence.image_size();
     let summary = Summary::from_records(&records, Residual::Keep, cost.into());
     let title = format!(
-        "stereocal hil: {} ({}), seed {}, firmware under QEMU",
+        "stereocal hil: {} ({}), seed {}, {machine}",
         args.scene,
         sequence.config().trajectory,
         args.seed
@@ -143,6 +200,90 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
             json_extra,
         },
     )
+}
+
+/// The SoC simulator's name, as `cargo build -p stereocal-hil --bin sc-soc-sim` builds it.
+const SOC_SIMULATOR: &str = "sc-soc-sim";
+
+/// The simulator `--soc` names: the given path, or without one `sc-soc-sim` next to this
+/// program (both in cargo's target directory) or on PATH.
+fn soc_simulator(given: &Path) -> anyhow::Result<PathBuf> {
+    if !given.as_os_str().is_empty() {
+        return Ok(given.to_path_buf());
+    }
+    let beside = std::env::current_exe()
+        .ok()
+        .and_then(|exe| exe.parent().map(|dir| dir.join(SOC_SIMULATOR)));
+    let on_path = std::env::var_os("PATH")
+        .into_iter()
+        .flat_map(|path| std::env::split_paths(&path).collect::<Vec<_>>())
+        .map(|dir| dir.join(SOC_SIMULATOR));
+    beside
+        .into_iter()
+        .chain(on_path)
+        .find(|candidate| candidate.is_file())
+        .with_context(|| {
+            format!(
+                "the SoC simulator {SOC_SIMULATOR} is neither beside this program nor on PATH: \
+                 build it with `cargo build --release -p stereocal-hil --bin {SOC_SIMULATOR}` \
+                 (needs verilator, python3-venv and, once, network for pip), or give its path \
+                 as --soc PATH"
+            )
+        })
+}
+
+/// What the SoC's board measured, on stderr and into the JSON summary.
+fn board_figures(board: &SocReport, json: &mut serde_json::Map<String, serde_json::Value>) {
+    let cycles = board.softcore_cycles_per_pair();
+    let clocks = board.sim_clocks_per_pair();
+    let latency = board.latency();
+    let speed = board.clocks_per_second();
+    eprintln!(
+        "SoC: soft-core cycles per pair (its own work, BUSY polling excluded) {}, simulated \
+         clocks per pair {}, FIFO overflows {}",
+        show(cycles),
+        show(clocks),
+        board.fifo_overflows()
+    );
+    if let Some(l) = latency {
+        eprintln!(
+            "SoC: worst image, first pixel in to last byte out {} clocks, last pixel in to \
+             last byte out {} clocks",
+            l.first_pixel_to_last_byte, l.last_pixel_to_last_byte
+        );
+    }
+    if let (Some(end), Some(speed)) = (board.end, speed) {
+        eprintln!(
+            "SoC: {} clocks in {:.1} s ({speed:.0} clocks/s), longest stillness {} clocks",
+            end.cycles,
+            end.millis as f64 / 1000.0,
+            end.longest_still
+        );
+    }
+    json.insert("softcore_cycles_per_pair".into(), cycles.into());
+    json.insert("sim_clocks_per_pair".into(), clocks.into());
+    json.insert("fifo_overflows".into(), board.fifo_overflows().into());
+    json.insert(
+        "pixel_clock_divider".into(),
+        board.end.map(|e| e.pixel_clock_divider).into(),
+    );
+    json.insert(
+        "latency_first_pixel_to_last_byte_clocks".into(),
+        latency.map(|l| l.first_pixel_to_last_byte).into(),
+    );
+    json.insert(
+        "latency_last_pixel_to_last_byte_clocks".into(),
+        latency.map(|l| l.last_pixel_to_last_byte).into(),
+    );
+    json.insert("sim_clocks_per_second".into(), speed.into());
+    json.insert(
+        "sim_longest_still_clocks".into(),
+        board.end.map(|e| e.longest_still).into(),
+    );
+}
+
+fn show(value: Option<u64>) -> String {
+    value.map_or_else(|| "unknown".into(), |v| v.to_string())
 }
 
 /// The soft-core's instructions per pixel, per image and over the run, on stderr.

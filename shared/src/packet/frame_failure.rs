@@ -38,6 +38,9 @@ pub enum FrameFailure {
     Encode,
     /// `9`: the fabric did not take FRAME_ARM (STATUS.BUSY stayed 0); value 0.
     NotArmed,
+    /// `10`: the fabric's stream engine fell behind the pixel rate (STREAM_FAULT.OVERRUN) and
+    /// stopped the frame; value: the row of the record that stopped it.
+    StreamOverrun,
     /// Any other cause byte.
     Unknown(u8),
 }
@@ -68,6 +71,7 @@ impl From<u8> for FrameFailure {
             7 => FrameFailure::PointOutOfFrame,
             8 => FrameFailure::Encode,
             9 => FrameFailure::NotArmed,
+            10 => FrameFailure::StreamOverrun,
             other => FrameFailure::Unknown(other),
         }
     }
@@ -85,6 +89,7 @@ impl From<FrameFailure> for u8 {
             FrameFailure::PointOutOfFrame => 7,
             FrameFailure::Encode => 8,
             FrameFailure::NotArmed => 9,
+            FrameFailure::StreamOverrun => 10,
             FrameFailure::Unknown(other) => other,
         }
     }

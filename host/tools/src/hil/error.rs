@@ -20,6 +20,8 @@ pub enum TimeoutKind {
     Answer,
     /// The firmware to end the simulation after the last frame.
     Exit,
+    /// The device to send anything at all.
+    Silence,
 }
 
 impl fmt::Display for TimeoutKind {
@@ -28,6 +30,7 @@ impl fmt::Display for TimeoutKind {
             Self::Startup => "startup",
             Self::Answer => "answer",
             Self::Exit => "exit",
+            Self::Silence => "silence",
         })
     }
 }
@@ -46,11 +49,12 @@ pub enum FirmwareExit {
 impl FirmwareExit {
     /// Reads QEMU's exit status.
     pub fn from_status(status: ExitStatus) -> Self {
-        const CODES: [ExitCode; 4] = [
+        const CODES: [ExitCode; 5] = [
             ExitCode::Success,
             ExitCode::Panic,
             ExitCode::BadInput,
             ExitCode::FrameFailed,
+            ExitCode::Trap,
         ];
         match status.code() {
             None => Self::Signal,
@@ -76,10 +80,14 @@ impl fmt::Display for FirmwareExit {
                     ExitCode::Panic => "the firmware panicked",
                     ExitCode::BadInput => "the frame input region is invalid",
                     ExitCode::FrameFailed => "a frame failed; an ErrorReport said why",
+                    ExitCode::Trap => "the core trapped; its log says where",
                 };
                 write!(f, "status {} ({meaning})", *code as u16)
             }
-            Self::Other(code) => write!(f, "status {code} (not a firmware exit code: QEMU failed)"),
+            Self::Other(code) => write!(
+                f,
+                "status {code} (not a firmware exit code: the machine itself stopped the run)"
+            ),
             Self::Signal => f.write_str("killed by a signal"),
         }
     }
@@ -144,8 +152,12 @@ pub enum HilError {
         /// Bytes of the region.
         available: usize,
     },
-    /// A timeout fired; QEMU was killed.
-    #[error("the {kind} timeout ({limit:?}) fired waiting for {waiting_for}; QEMU was killed")]
+    /// A timeout fired; the machine was killed.
+    #[error(
+        "the {kind} timeout ({limit:?}) fired waiting for {waiting_for}; the machine was \
+         killed{}",
+        log_suffix(log)
+    )]
     Timeout {
         /// Which timeout.
         kind: TimeoutKind,
@@ -153,9 +165,11 @@ pub enum HilError {
         limit: Duration,
         /// What the host was waiting for.
         waiting_for: String,
+        /// What the firmware had logged (decoded), one message a line.
+        log: String,
     },
     /// QEMU ended before the run did.
-    #[error("QEMU ended early, {exit}{}", stderr_suffix(stderr))]
+    #[error("the machine ended early, {exit}{}", stderr_suffix(stderr))]
     EndedEarly {
         /// How it ended.
         exit: FirmwareExit,
@@ -177,7 +191,11 @@ pub enum HilError {
     #[error(transparent)]
     Link(#[from] LinkError),
     /// The session on the emulated device failed; QEMU was stopped.
-    #[error("{source}; QEMU {exit}{}{}", stderr_suffix(stderr), log_suffix(log))]
+    #[error(
+        "{source}; the machine: {exit}{}{}",
+        stderr_suffix(stderr),
+        log_suffix(log)
+    )]
     Device {
         /// What failed (boxed: the session's errors are large and this one is rare).
         #[source]
@@ -197,12 +215,19 @@ impl From<EvalError> for HilError {
     }
 }
 
+/// What the machine said, less the SoC board's measurement lines (`SocReport`).
 fn stderr_suffix(stderr: &str) -> String {
-    let stderr = stderr.trim();
-    if stderr.is_empty() {
+    let said: Vec<&str> = stderr
+        .lines()
+        .filter(|line| {
+            !line.starts_with("sc_soc_sim: image ") && !line.starts_with("sc_soc_sim: timing ")
+        })
+        .filter(|line| !line.trim().is_empty())
+        .collect();
+    if said.is_empty() {
         String::new()
     } else {
-        format!("; QEMU said: {stderr}")
+        format!("; the machine said: {}", said.join("\n"))
     }
 }
 

@@ -14,9 +14,13 @@ mod error;
 mod input;
 mod qemu;
 mod run;
+mod soc_report;
+mod stream_compare;
 
 pub use device_log::{instruction_reports, kernel_report, DeviceLog, LogDecoder};
 pub use error::{FirmwareExit, HilError, TimeoutKind};
 pub use input::GrabberInput;
 pub use qemu::{QemuConfig, QemuDevice, QemuEnd, QemuTimeouts, DEFAULT_QEMU};
-pub use run::{run_on_qemu, run_sequence, QemuRun};
+pub use run::{run_on_qemu, run_sequence, QemuRun, SequenceRun};
+pub use soc_report::{ImageTiming, Latency, SimEnd, SocReport};
+pub use stream_compare::{compare_streams, StreamMismatch};

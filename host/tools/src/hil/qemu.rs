@@ -61,6 +61,11 @@ pub struct QemuTimeouts {
     pub answer: Duration,
     /// The firmware to end the simulation after the last frame.
     pub exit: Duration,
+    /// The device to send anything at all. A healthy firmware is never quiet this long: its
+    /// stream engine sends each frame's packets as the rows complete, and `hil` prints the
+    /// longest silence of every run (well under a second under QEMU at 640x480); a device
+    /// silent this long hangs, and the run ends with that error, once.
+    pub silence: Duration,
 }
 
 impl Default for QemuTimeouts {
@@ -69,6 +74,21 @@ impl Default for QemuTimeouts {
             startup: Duration::from_secs(10),
             answer: Duration::from_secs(120),
             exit: Duration::from_secs(30),
+            silence: Duration::from_secs(10),
+        }
+    }
+}
+
+impl QemuTimeouts {
+    /// The SoC in the loop's: an hour for an answer and for silence. A 640x480 pair is
+    /// minutes of simulation there, and the board itself ends a firmware that hangs (its
+    /// watchdog, after a million clocks in which nothing moved), so the host's own limits
+    /// only catch a simulator that stopped.
+    pub fn soc() -> Self {
+        Self {
+            answer: Duration::from_secs(3600),
+            silence: Duration::from_secs(3600),
+            ..Self::default()
         }
     }
 }
@@ -90,6 +110,9 @@ pub struct QemuConfig {
     /// firmware drives the real fabric and the harness's cameras send the images. Its
     /// `minstret` counts retired instructions without `-icount`.
     pub soc: Option<PathBuf>,
+    /// On the SoC: the cameras' pixel clock, one clock in this many; `None` keeps the board's
+    /// default (64, the stream engine's pace).
+    pub pixel_clock_divider: Option<u32>,
     /// The timeouts.
     pub timeouts: QemuTimeouts,
 }
@@ -102,6 +125,7 @@ impl QemuConfig {
             elf: elf.into(),
             count_instructions: false,
             soc: None,
+            pixel_clock_divider: None,
             timeouts: QemuTimeouts::default(),
         }
     }
@@ -116,6 +140,8 @@ pub struct QemuEnd {
     pub transcript: Vec<u8>,
     /// What QEMU printed on stderr.
     pub stderr: String,
+    /// The longest the device was silent while the host waited for it.
+    pub longest_silence: Duration,
 }
 
 /// The QEMU process; dropping it kills a QEMU that is still running.
@@ -191,6 +217,12 @@ pub struct QemuDevice {
     loaded: Vec<PairDigest>,
     submitted: usize,
     timeouts: QemuTimeouts,
+    /// When the host began waiting without getting a byte since.
+    quiet_since: Option<Instant>,
+    /// The longest silence so far.
+    longest_silence: Duration,
+    /// Set once the device has been silent for [`QemuTimeouts::silence`].
+    silent: Option<Duration>,
     _dir: tempfile::TempDir,
 }
 
@@ -225,7 +257,7 @@ impl QemuDevice {
         let socket = dir.path().join("uart.sock");
 
         let mut command = match &config.soc {
-            Some(sim) => soc_command(sim, &config.elf, &socket, &frames),
+            Some(sim) => soc_command(sim, config, &socket, &frames),
             None => qemu_command(config, &socket, &frames),
         };
         let program = config.soc.as_ref().unwrap_or(&config.qemu);
@@ -272,6 +304,7 @@ impl QemuDevice {
                             "{machine} to open its UART socket {}",
                             socket.display()
                         ),
+                        log: String::new(),
                     })
                 }
             }
@@ -285,8 +318,27 @@ impl QemuDevice {
             loaded: input.digests.clone(),
             submitted: 0,
             timeouts: config.timeouts,
+            quiet_since: None,
+            longest_silence: Duration::ZERO,
+            silent: None,
             _dir: dir,
         })
+    }
+
+    /// How long the device had been silent when it was found hung, if it was (see
+    /// [`Link::recv`] of this type).
+    pub fn silent_for(&self) -> Option<Duration> {
+        self.silent
+    }
+
+    fn hung(&self, silent: Duration) -> LinkError {
+        LinkError::Io {
+            link: self.link.inner().name().into(),
+            source: io::Error::new(
+                io::ErrorKind::TimedOut,
+                format!("no byte for {silent:?}: the firmware hangs or the machine stopped"),
+            ),
+        }
     }
 
     /// Ends a run that went well: reads the UART to its end and waits for the firmware to
@@ -298,6 +350,7 @@ impl QemuDevice {
             kind: TimeoutKind::Exit,
             limit,
             waiting_for: waiting_for.into(),
+            log: String::new(),
         };
         let mut buf = vec![0; READ_CHUNK];
         loop {
@@ -320,6 +373,7 @@ impl QemuDevice {
             exit,
             transcript: self.link.take_received(),
             stderr: self.process.stderr(),
+            longest_silence: self.longest_silence,
         })
     }
 
@@ -337,6 +391,7 @@ impl QemuDevice {
             exit,
             transcript: self.link.take_received(),
             stderr: self.process.stderr(),
+            longest_silence: self.longest_silence,
         }
     }
 }
@@ -351,8 +406,33 @@ impl Link for QemuDevice {
         self.link.send(bytes)
     }
 
+    /// A device that sends nothing for [`QemuTimeouts::silence`] hangs (or its machine
+    /// stopped): from then on every receive fails at once with an error, not a timeout, so
+    /// the session stops instead of waiting its answer timeout for every remaining frame.
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
-        self.link.recv(buf, deadline)
+        if let Some(silent) = self.silent {
+            return Err(self.hung(silent));
+        }
+        // Silence starts when the host begins to wait after the last byte it got (not at
+        // that byte: the host may have been busy since, with bytes waiting in the socket) and
+        // goes on across receives that time out.
+        let since = *self.quiet_since.get_or_insert_with(Instant::now);
+        let watch = since + self.timeouts.silence;
+        let result = self.link.recv(buf, deadline.min(watch));
+        let now = Instant::now();
+        self.longest_silence = self.longest_silence.max(now - since);
+        match result {
+            Ok(n) => {
+                self.quiet_since = None;
+                Ok(n)
+            }
+            Err(LinkError::Timeout { .. }) if now >= watch => {
+                let silent = now - since;
+                self.silent = Some(silent);
+                Err(self.hung(silent))
+            }
+            Err(e) => Err(e),
+        }
     }
 
     fn answer_timeout(&self) -> Duration {
@@ -416,17 +496,22 @@ fn qemu_command(config: &QemuConfig, socket: &Path, frames: &Path) -> Command {
 
 /// The SoC simulator's command line (`hdl-interface/soc/sim/sc_soc_sim.cpp`): the same ELF,
 /// frame file and socket as QEMU's.
-fn soc_command(sim: &Path, elf: &Path, socket: &Path, frames: &Path) -> Command {
+fn soc_command(sim: &Path, config: &QemuConfig, socket: &Path, frames: &Path) -> Command {
     let mut command = Command::new(sim);
     command
         .arg("--elf")
-        .arg(elf)
+        .arg(&config.elf)
         .arg("--uart")
         .arg(socket)
         .arg("--load")
         .arg(format!("{}@{VIRT_FRAME_REGION:#x}", frames.display()))
         .arg("--frames")
         .arg(frames);
+    if let Some(divider) = config.pixel_clock_divider {
+        command
+            .arg("--pixel-clock-divider")
+            .arg(divider.to_string());
+    }
     command
 }
 

@@ -5,9 +5,12 @@ use rayon::prelude::*;
 
 use super::device_log::{DeviceLog, LogDecoder};
 use super::qemu::{QemuConfig, QemuDevice, QemuEnd};
+use super::soc_report::SocReport;
+use super::stream_compare::{compare_streams, StreamMismatch};
 use super::{GrabberInput, HilError, TimeoutKind};
 use crate::eval::{evaluate_frames, fabric_size, sequence_calibration, EvalError};
 use stereocal::driver::DriverError;
+use stereocal::link::{InProcessLink, Recording};
 use stereocal::output::record::FrameRecord;
 use stereocal::session::{Session, SessionConfig, SessionCost, SessionError};
 use stereocal_synth::Sequence;
@@ -21,6 +24,21 @@ pub struct QemuRun<T> {
     pub end: QemuEnd,
     /// The firmware's logs, decoded with the ELF's defmt table.
     pub logs: Vec<DeviceLog>,
+    /// What the SoC in the loop's board measured ([`QemuConfig::soc`]); `None` under QEMU.
+    pub board: Option<SocReport>,
+}
+
+/// What `stereocal hil` gave: the run on the device, and the same frames on the in-process
+/// device beside it.
+#[derive(Debug)]
+pub struct SequenceRun {
+    /// The run on the device: records and the session's cost.
+    pub device: QemuRun<(Vec<FrameRecord>, SessionCost)>,
+    /// Whether the device's bytes after its `Hello` were the in-process device's; `None` when
+    /// the firmware counted instructions (its reports are extra `Log` packets on the link).
+    pub wire: Option<Result<(), StreamMismatch>>,
+    /// Whether the host's records of both runs are equal, every float to the bit.
+    pub records_identical: bool,
 }
 
 /// Starts QEMU on `config.elf` with `input` in its frame region, runs `session` on the
@@ -45,10 +63,18 @@ pub fn run_on_qemu<T>(
                     log: messages(&logs),
                 });
             }
-            Ok(QemuRun { value, end, logs })
+            let board = config.soc.is_some().then(|| SocReport::parse(&end.stderr));
+            Ok(QemuRun {
+                value,
+                end,
+                logs,
+                board,
+            })
         }
         Err(source) => {
+            let silent = device.silent_for();
             let end = device.abort();
+            let log = messages(&decoder.logs(&end.transcript));
             Err(match source {
                 EvalError::Session(SessionError::Driver(DriverError::Timeout {
                     waiting_for,
@@ -57,11 +83,20 @@ pub fn run_on_qemu<T>(
                     kind: TimeoutKind::Answer,
                     limit: timeout,
                     waiting_for: waiting_for.to_string(),
+                    log,
+                },
+                _ if silent.is_some() => HilError::Timeout {
+                    kind: TimeoutKind::Silence,
+                    limit: config.timeouts.silence,
+                    waiting_for: "any byte from the device (the firmware hangs, or the machine \
+                                  stopped)"
+                        .into(),
+                    log,
                 },
                 source => HilError::Device {
                     source: Box::new(source),
                     exit: end.exit,
-                    log: messages(&decoder.logs(&end.transcript)),
+                    log,
                     stderr: end.stderr,
                 },
             })
@@ -71,13 +106,14 @@ pub fn run_on_qemu<T>(
 
 /// `stereocal hil`: every frame of `sequence` through the firmware under QEMU, then the host
 /// chain exactly as `eval` runs it on the in-process device; `progress` is called after each
-/// frame. Returns the records and the session's cost.
+/// frame. Then the same frames on the in-process device, whose bytes and records the device's
+/// are compared with.
 pub fn run_sequence(
     config: &QemuConfig,
     sequence: &Sequence,
     session_config: SessionConfig,
     progress: &mut dyn FnMut(&FrameRecord),
-) -> Result<QemuRun<(Vec<FrameRecord>, SessionCost)>, HilError> {
+) -> Result<SequenceRun, HilError> {
     let calib = sequence_calibration(sequence).map_err(EvalError::from)?;
     let (width, height) = fabric_size(sequence)?;
     // QEMU needs every pair before it boots, so the whole sequence is rendered first.
@@ -96,11 +132,34 @@ pub fn run_sequence(
             )?;
         }
     }
-    run_on_qemu(config, &input, |device| {
+    let device = run_on_qemu(config, &input, |device| {
         let mut session = Session::with_device(device, calib, width, height, session_config)?;
-        let records =
-            evaluate_frames(&mut session, sequence, frames.into_iter().map(Ok), progress)?;
+        let records = evaluate_frames(
+            &mut session,
+            sequence,
+            frames.iter().cloned().map(Ok),
+            progress,
+        )?;
         Ok((records, session.cost()))
+    })?;
+
+    let mut in_process = Recording::new(InProcessLink::new()?);
+    let mut session = Session::with_device(&mut in_process, calib, width, height, session_config)
+        .map_err(EvalError::from)?;
+    let records = evaluate_frames(
+        &mut session,
+        sequence,
+        frames.into_iter().map(Ok),
+        &mut |_| {},
+    )?;
+    drop(session);
+    let wire = (!config.count_instructions)
+        .then(|| compare_streams(&device.end.transcript, &in_process.take_received()));
+    let records_identical = records == device.value.0;
+    Ok(SequenceRun {
+        device,
+        wire,
+        records_identical,
     })
 }
 
