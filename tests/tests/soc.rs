@@ -2,34 +2,87 @@
 //! RV32IMAC core (VexRiscv from PyPI) with both channels' `sc_fabric` and stream engines on
 //! its bus, cameras wired to them, under Verilator with the `virt` machine's RAM, UART and
 //! finisher around it (`hdl-interface/soc/`), speaking to the same host driver and session.
-//! The bytes on its link (the UART and both LINK_OUT ports) must be the in-process device's,
-//! as QEMU's are (`tests/tests/qemu.rs`), and its records equal to the bit.
+//! `stereocal hil --soc`'s run of two 128x96 road pairs, in both Sobel modes: its link bytes
+//! (the UART and both LINK_OUT ports) are the in-process device's, its records and its
+//! `verge.csv` those of `stereocal eval` on the same sequence, and the board's figures are
+//! there: the soft-core's cycles per pair within the budget, no FIFO overflow.
 //!
 //! Needs verilator, python3 with venv and, on the first run, network for pip; builds the
 //! simulator and the ELF itself.
 
+use stereocal::output::record::FrameRecord;
+use stereocal::output::verge_csv::write_verge_csv;
 use stereocal::session::SessionConfig;
-use stereocal_hil::{
-    assert_same_records, assert_same_stream, run_in_process, run_qemu, soc_or_skip, Scenario,
-};
-use stereocal_synth::SceneKind;
+use stereocal_hdl::regs::output_mode::SobelOutput;
+use stereocal_hil::soc_or_skip;
+use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
+use stereocal_tools::eval::evaluate;
+use stereocal_tools::hil::run_sequence;
 
-#[test]
-fn soc_runs_the_release_elf_and_sends_the_in_process_bytes() {
-    let test = "soc_runs_the_release_elf_and_sends_the_in_process_bytes";
+/// The soft-core's clock cycles for its own work per pair: a 100 MHz core at 60 pairs a
+/// second (the budget `tests/tests/qemu.rs` holds QEMU's instruction counts to).
+const BUDGET: u64 = 1_600_000;
+
+fn hil_equals_eval(test: &str, sobel_output: SobelOutput) {
     let Some(soc) = soc_or_skip(test) else {
         return;
     };
-    let scenario = Scenario::synthetic(SceneKind::Road, 128, 96, 2, SessionConfig::default());
-    let reference = run_in_process(&scenario);
-    let (on_soc, run) = run_qemu(&scenario, &soc).unwrap_or_else(|e| panic!("{test}: {e}"));
-    assert!(run.end.exit.is_success(), "{test}: {}", run.end.exit);
-    assert_same_stream(&scenario.name, &on_soc.bytes, &reference.bytes);
-    assert_same_records(&scenario.name, &on_soc.records, &reference.records);
-    eprintln!(
-        "{test}: {} UART bytes identical to in-process; SoC run {:.1} s ({})",
-        on_soc.bytes.len(),
-        on_soc.seconds,
-        run.end.stderr.trim()
+    let sequence = Sequence::builtin(
+        SceneKind::Road,
+        SequenceConfig {
+            width: 128,
+            height: 96,
+            frames: 2,
+            ..SequenceConfig::for_scene(SceneKind::Road)
+        },
+    )
+    .unwrap();
+    let config = SessionConfig {
+        sobel_output,
+        ..SessionConfig::default()
+    };
+    let (eval, _) = evaluate(&sequence, config, &mut |_| {}).unwrap();
+    let run = run_sequence(&soc, &sequence, config, &mut |_| {})
+        .unwrap_or_else(|e| panic!("{test}: {e}"));
+    assert!(
+        run.device.end.exit.is_success(),
+        "{test}: {}",
+        run.device.end.exit
     );
+    assert_eq!(run.wire, Some(Ok(())), "{test}: link bytes");
+    assert!(run.records_identical, "{test}: records");
+    let csv = |records: &[FrameRecord]| {
+        let mut out = Vec::new();
+        write_verge_csv(&mut out, records).unwrap();
+        out
+    };
+    assert_eq!(csv(&run.device.value.0), csv(&eval), "{test}: verge.csv");
+
+    let board = run.device.board.as_ref().expect("the SoC's board reports");
+    let cycles = board.softcore_cycles_per_pair().expect("cycle reports");
+    assert!(
+        cycles <= BUDGET,
+        "{test}: {cycles} soft-core cycles per pair"
+    );
+    assert_eq!(board.fifo_overflows(), 0, "{test}: FIFO overflows");
+    let clocks = board.sim_clocks_per_pair().expect("timing lines");
+    let latency = board.latency().expect("timing lines");
+    eprintln!(
+        "{test}: {} link bytes identical to in-process, verge.csv equal to eval's; soft-core \
+         cycles per pair {cycles}, simulated clocks per pair {clocks}, first pixel to last \
+         byte {} clocks, {:.0} clocks/s",
+        run.device.end.transcript.len(),
+        latency.first_pixel_to_last_byte,
+        board.clocks_per_second().unwrap_or(0.0)
+    );
+}
+
+#[test]
+fn soc_hil_equals_eval_sobel_patches() {
+    hil_equals_eval("soc_hil_equals_eval_sobel_patches", SobelOutput::Patches);
+}
+
+#[test]
+fn soc_hil_equals_eval_sobel_rows() {
+    hil_equals_eval("soc_hil_equals_eval_sobel_rows", SobelOutput::Rows);
 }

@@ -62,17 +62,17 @@ pub enum StreamMismatch {
 pub fn compare_streams(device: &[u8], in_process: &[u8]) -> Result<(), StreamMismatch> {
     let (d_hello, d_rest) = split_hello(device, "device")?;
     let (i_hello, i_rest) = split_hello(in_process, "in-process device")?;
-    if d_hello.0 != i_hello.0
-        || d_hello.1 != i_hello.1
-        || d_hello.2 != i_hello.2 | Capabilities::LOG.0
+    if d_hello.seq != i_hello.seq
+        || d_hello.version != i_hello.version
+        || d_hello.capabilities != i_hello.capabilities | Capabilities::LOG.0
     {
         return Err(StreamMismatch::Hello {
-            device_seq: d_hello.0,
-            device_version: d_hello.1,
-            device_caps: d_hello.2,
-            in_process_seq: i_hello.0,
-            in_process_version: i_hello.1,
-            in_process_caps: i_hello.2,
+            device_seq: d_hello.seq,
+            device_version: d_hello.version,
+            device_caps: d_hello.capabilities,
+            in_process_seq: i_hello.seq,
+            in_process_version: i_hello.version,
+            in_process_caps: i_hello.capabilities,
         });
     }
     if d_rest == i_rest {
@@ -91,11 +91,18 @@ pub fn compare_streams(device: &[u8], in_process: &[u8]) -> Result<(), StreamMis
     })
 }
 
-/// The first link frame's `Hello` (sequence, version, capabilities) and the bytes after it.
+/// What a stream's `Hello` says.
+struct Hello {
+    seq: u16,
+    version: u8,
+    capabilities: u32,
+}
+
+/// The first link frame's `Hello` and the bytes after it.
 fn split_hello<'a>(
     bytes: &'a [u8],
     who: &'static str,
-) -> Result<((u16, u8, u32), &'a [u8]), StreamMismatch> {
+) -> Result<(Hello, &'a [u8]), StreamMismatch> {
     let end = bytes
         .iter()
         .position(|&b| b == DELIMITER)
@@ -103,9 +110,14 @@ fn split_hello<'a>(
     let (first, rest) = bytes.split_at(end + 1);
     let mut frame = first.to_vec();
     match decode(&mut frame) {
-        Ok((header, PacketRepr::Hello(hello))) => {
-            Ok(((header.seq, hello.version, hello.capabilities.0), rest))
-        }
+        Ok((header, PacketRepr::Hello(hello))) => Ok((
+            Hello {
+                seq: header.seq,
+                version: hello.version,
+                capabilities: hello.capabilities.0,
+            },
+            rest,
+        )),
         _ => Err(StreamMismatch::NoHello { who }),
     }
 }
