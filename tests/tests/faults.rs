@@ -146,7 +146,7 @@ fn soc_hung_firmware_is_ended_by_the_board_watchdog() {
         }
         other => panic!("{test}: not the watchdog's error: {other}"),
     }
-    // A million simulated clocks at some 100,000 a second, and the board's start.
+    // 400,000 simulated clocks at some 100,000 a second, and the board's start.
     assert!(took < Duration::from_secs(60), "{test}: took {took:?}");
     eprintln!("{test}: {took:.1?}: {err}");
 }

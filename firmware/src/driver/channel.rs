@@ -288,7 +288,7 @@ fn stream_fault(word: u32) -> Result<(), DriverError> {
     let x = stream_fault::X.extract(word) as u16;
     let y = stream_fault::Y.extract(word) as u16;
     if stream_fault::OVERRUN.extract(word) != 0 {
-        return Err(DriverError::StreamOverrun { octave, y });
+        return Err(DriverError::StreamOverrun);
     }
     match Cause::from_bits(stream_fault::CAUSE.extract(word)) {
         Some(Cause::None) | None => Ok(()),
@@ -319,4 +319,27 @@ fn unknown_register(addr: u16) -> PacketRepr<'static> {
         code: ErrorCode::UnknownRegister,
         detail: u32::from(addr),
     })
+}
+
+#[cfg(test)]
+mod stream_fault_tests {
+    use super::*;
+
+    #[test]
+    fn an_overrun_fails_the_frame_beside_any_cause() {
+        assert!(stream_fault(0).is_ok());
+        assert!(matches!(
+            stream_fault(stream_fault::OVERRUN.mask()),
+            Err(DriverError::StreamOverrun)
+        ));
+        let encode = stream_fault::CAUSE.insert(0, Cause::Encode as u32).unwrap();
+        assert!(matches!(
+            stream_fault(encode | stream_fault::OVERRUN.mask()),
+            Err(DriverError::StreamOverrun)
+        ));
+        assert!(matches!(
+            stream_fault(encode),
+            Err(DriverError::StreamEncode)
+        ));
+    }
 }

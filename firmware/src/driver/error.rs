@@ -51,14 +51,9 @@ pub enum DriverError {
     /// The fabric's stream engine stopped the frame at a packet its framer refused (an engine
     /// defect; STREAM_FAULT).
     StreamEncode,
-    /// The fabric's stream engine fell behind the pixel rate and stopped the frame at row `y`
-    /// of `octave` (STREAM_FAULT.OVERRUN): the camera is too fast for the engine's clock.
-    StreamOverrun {
-        /// Octave of the record that stopped it.
-        octave: u8,
-        /// Its row.
-        y: u16,
-    },
+    /// The fabric's stream engine fell behind the pixel rate and stopped the frame
+    /// (STREAM_FAULT.OVERRUN): the camera is too fast for the engine's clock.
+    StreamOverrun,
     /// The fabric did not take FRAME_ARM: STATUS.BUSY stayed 0.
     NotArmed,
 }
@@ -97,7 +92,7 @@ impl DriverError {
             Self::PointOutOfFrame { y, .. } => (FrameFailure::PointOutOfFrame, u32::from(y)),
             Self::Encode(_) | Self::StreamEncode => (FrameFailure::Encode, 0),
             Self::NotArmed => (FrameFailure::NotArmed, 0),
-            Self::StreamOverrun { y, .. } => (FrameFailure::StreamOverrun, u32::from(y)),
+            Self::StreamOverrun => (FrameFailure::StreamOverrun, 0),
         };
         cause.detail(value)
     }
@@ -145,10 +140,10 @@ impl fmt::Display for DriverError {
             Self::Encode(e) => write!(f, "packet encoding: {e}"),
             Self::StreamEncode => write!(f, "the stream engine could not encode a packet"),
             Self::NotArmed => write!(f, "the fabric did not take FRAME_ARM (STATUS.BUSY stayed 0)"),
-            Self::StreamOverrun { octave, y } => write!(
+            Self::StreamOverrun => write!(
                 f,
-                "the stream engine fell behind the camera at row {y} of octave {octave} \
-                 (STREAM_FAULT.OVERRUN): its clock is too slow for the pixel rate"
+                "the stream engine fell behind the camera (STREAM_FAULT.OVERRUN): its clock is \
+                 too slow for the pixel rate"
             ),
         }
     }

@@ -34,7 +34,7 @@
 // - --max-cycles (default: none) ends a run that did not finish with exit status 124 and a
 //   message naming the limit; the host side reports it as a timeout.
 // - The watchdog: a run in which nothing moves for --watchdog-cycles clocks (default
-//   1,000,000; 0 turns it off) ends with exit status 124 and a message saying what stood
+//   400,000; 0 turns it off) ends with exit status 124 and a message saying what stood
 //   still and where the core last fetched. Moving is a camera pixel taken or a byte on the
 //   link either way; polling registers is not (a firmware stuck waiting for a camera that
 //   never sends polls STATUS forever). A healthy run's longest stillness is printed at exit
@@ -268,7 +268,10 @@ struct Args {
     std::vector<std::pair<std::string, uint32_t>> loads;
     uint64_t ram_mib = 128;
     uint64_t max_cycles = 0;
-    uint64_t watchdog = 1000000;
+    // Ten times the longest stillness of a healthy 640x480 pair (40,123 clocks: the stream
+    // engine's end-of-frame passes; `stereocal hil --soc --width 640 --height 480 --json`,
+    // sim_longest_still_clocks), a few seconds of simulation.
+    uint64_t watchdog = 400000;
 };
 
 Args parse(int argc, char **argv) {

@@ -55,7 +55,7 @@ pub struct HilArgs {
     pixel_clock_divider: Option<u32>,
     /// Seconds to wait for one answer or frame pair (default: 120 under QEMU, where a run
     /// whose link is silent for 10 s ends as hung; 3600 on the SoC, where a 640x480 pair is
-    /// minutes of simulation and the board itself ends a firmware that hangs after a million
+    /// minutes of simulation and the board itself ends a firmware that hangs after 400,000
     /// clocks in which nothing moved).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=86_400))]
     timeout: Option<u64>,

@@ -39,7 +39,7 @@ pub enum FrameFailure {
     /// `9`: the fabric did not take FRAME_ARM (STATUS.BUSY stayed 0); value 0.
     NotArmed,
     /// `10`: the fabric's stream engine fell behind the pixel rate (STREAM_FAULT.OVERRUN) and
-    /// stopped the frame; value: the row of the record that stopped it.
+    /// stopped the frame; value 0.
     StreamOverrun,
     /// Any other cause byte.
     Unknown(u8),

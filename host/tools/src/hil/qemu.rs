@@ -82,7 +82,7 @@ impl Default for QemuTimeouts {
 impl QemuTimeouts {
     /// The SoC in the loop's: an hour for an answer and for silence. A 640x480 pair is
     /// minutes of simulation there, and the board itself ends a firmware that hangs (its
-    /// watchdog, after a million clocks in which nothing moved), so the host's own limits
+    /// watchdog, after 400,000 clocks in which nothing moved), so the host's own limits
     /// only catch a simulator that stopped.
     pub fn soc() -> Self {
         Self {
