@@ -5,8 +5,9 @@
 //! The bytes on its link (the UART and both LINK_OUT ports) must be the in-process device's,
 //! as QEMU's are (`tests/tests/qemu.rs`), and its records equal to the bit.
 //!
-//! Needs verilator, python3 with venv and, on the first run, network for pip; builds the
-//! simulator and the ELF itself.
+//! The simulator is this package's binary `sc-soc-sim`, which `build.rs` builds (it needs
+//! verilator, python3 with venv and, on the first build, network for pip); the test builds
+//! the ELF itself.
 
 use stereocal::session::SessionConfig;
 use stereocal_hil::{
@@ -17,7 +18,7 @@ use stereocal_synth::SceneKind;
 #[test]
 fn soc_runs_the_release_elf_and_sends_the_in_process_bytes() {
     let test = "soc_runs_the_release_elf_and_sends_the_in_process_bytes";
-    let Some(soc) = soc_or_skip(test) else {
+    let Some(soc) = soc_or_skip(test, env!("CARGO_BIN_EXE_sc-soc-sim")) else {
         return;
     };
     let scenario = Scenario::synthetic(SceneKind::Road, 128, 96, 2, SessionConfig::default());

@@ -41,8 +41,8 @@ pub struct HilArgs {
     #[arg(long, default_value = DEFAULT_QEMU)]
     qemu: PathBuf,
     /// Run the ELF on the SoC in the loop instead of QEMU: a real RV32IMAC core (VexRiscv)
-    /// under Verilator, the simulator `bash hdl-interface/soc/build.sh DIR` builds as
-    /// DIR/sc_soc_sim.
+    /// under Verilator, the simulator `cargo build --release -p stereocal-hil --bin
+    /// sc-soc-sim` builds as target/release/sc-soc-sim.
     #[arg(long, value_name = "SC_SOC_SIM")]
     soc: Option<PathBuf>,
     /// Seconds to wait for one answer or frame pair from the emulated device.
