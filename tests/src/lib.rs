@@ -23,6 +23,10 @@
 //! [`rtl`] clocks `sc_frontend` beside the register-level model and compares every
 //! observation port; [`fabric_contract`] clocks the whole `sc_fabric` ([`rtl_fabric`]) beside
 //! the device model's clock-exact entry point and compares every word read over the bus.
+//!
+//! The SoC in the loop (the binary `sc-soc-sim`, whose model `build.rs` builds beside the
+//! co-simulations' and leaves out, with a reason, where a tool is missing): [`soc_or_skip`]
+//! runs the ELF on it in place of QEMU.
 
 pub mod fabric_contract;
 pub mod rng;
@@ -218,55 +222,23 @@ pub fn qemu_or_skip(test: &str) -> Option<QemuConfig> {
     firmware_elf_or_skip(test).map(QemuConfig::new)
 }
 
-/// The firmware ELF on the SoC in the loop ([`QemuConfig::soc`]): the simulator built once
-/// per test binary by `hdl-interface/soc/build.sh` into `target/soc` (it fetches the core
-/// from PyPI into a venv there and verilates it), or `None` after a loud `SKIPPED` line when
-/// a tool it needs is missing or the build fails (a failure under `CI=true`).
-pub fn soc_or_skip(test: &str) -> Option<QemuConfig> {
-    static SIM: OnceLock<Result<PathBuf, String>> = OnceLock::new();
-    let sim = match SIM.get_or_init(build_soc) {
-        Ok(sim) => sim.clone(),
-        Err(reason) => {
-            skip(test, reason);
-            return None;
-        }
-    };
+/// Why `build.rs` left the SoC model out of the binary `sc-soc-sim` (`None` when it is in).
+pub const SOC_SKIP: Option<&str> = option_env!("STEREOCAL_SOC_SKIP");
+
+/// The firmware ELF on the SoC in the loop ([`QemuConfig::soc`]) run by `sim`, this package's
+/// binary `sc-soc-sim` (a test passes `env!("CARGO_BIN_EXE_sc-soc-sim")`: Cargo tells its
+/// path to integration tests only), or `None` after a loud `SKIPPED` line when the binary
+/// has no model ([`SOC_SKIP`]). Under `CI=true` the build has failed instead.
+pub fn soc_or_skip(test: &str, sim: impl Into<PathBuf>) -> Option<QemuConfig> {
+    if let Some(why) = SOC_SKIP {
+        skip(test, &format!("sc-soc-sim has no SoC model: {why}"));
+        return None;
+    }
     firmware_elf_or_skip(test).map(|elf| QemuConfig {
-        soc: Some(sim),
+        soc: Some(sim.into()),
         timeouts: QemuTimeouts::soc(),
         ..QemuConfig::new(elf)
     })
-}
-
-fn build_soc() -> Result<PathBuf, String> {
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("tests/ sits in the workspace");
-    for (tool, install) in [
-        ("verilator", "apt-get install verilator"),
-        ("python3", "apt-get install python3 python3-venv"),
-    ] {
-        let found = Command::new(tool)
-            .arg("--version")
-            .output()
-            .is_ok_and(|out| out.status.success());
-        if !found {
-            return Err(format!("`{tool}` not found on PATH ({install})"));
-        }
-    }
-    let out = workspace.join("target").join("soc");
-    let built = Command::new("bash")
-        .arg(workspace.join("hdl-interface/soc/build.sh"))
-        .arg(&out)
-        .output()
-        .map_err(|e| format!("cannot run hdl-interface/soc/build.sh: {e}"))?;
-    if !built.status.success() {
-        return Err(format!(
-            "hdl-interface/soc/build.sh failed (network for pip, python3-venv?): {}",
-            String::from_utf8_lossy(&built.stderr).trim()
-        ));
-    }
-    Ok(out.join("sc_soc_sim"))
 }
 
 /// The soft-core's Rust target: the firmware ELF is built for it.

@@ -130,7 +130,7 @@ fn qemu_trap_ends_the_run_at_once_with_the_cause() {
 #[test]
 fn soc_hung_firmware_is_ended_by_the_board_watchdog() {
     let test = "soc_hung_firmware_is_ended_by_the_board_watchdog";
-    let Some(soc) = soc_or_skip(test) else {
+    let Some(soc) = soc_or_skip(test, env!("CARGO_BIN_EXE_sc-soc-sim")) else {
         return;
     };
     assert_eq!(
@@ -154,7 +154,7 @@ fn soc_hung_firmware_is_ended_by_the_board_watchdog() {
 #[test]
 fn soc_trap_ends_the_run_at_once_with_the_cause() {
     let test = "soc_trap_ends_the_run_at_once_with_the_cause";
-    let Some(soc) = soc_or_skip(test) else {
+    let Some(soc) = soc_or_skip(test, env!("CARGO_BIN_EXE_sc-soc-sim")) else {
         return;
     };
     let (err, took, _elf) = run_faulty(&soc, ECALL);

@@ -7,8 +7,9 @@
 //! `verge.csv` those of `stereocal eval` on the same sequence, and the board's figures are
 //! there: the soft-core's cycles per pair within the budget, no FIFO overflow.
 //!
-//! Needs verilator, python3 with venv and, on the first run, network for pip; builds the
-//! simulator and the ELF itself.
+//! The simulator is this package's binary `sc-soc-sim`, which `build.rs` builds (it needs
+//! verilator, python3 with venv and, on the first build, network for pip); the test builds
+//! the ELF itself.
 
 use stereocal::output::record::FrameRecord;
 use stereocal::output::verge_csv::write_verge_csv;
@@ -24,7 +25,7 @@ use stereocal_tools::hil::run_sequence;
 const BUDGET: u64 = 1_600_000;
 
 fn hil_equals_eval(test: &str, sobel_output: SobelOutput) {
-    let Some(soc) = soc_or_skip(test) else {
+    let Some(soc) = soc_or_skip(test, env!("CARGO_BIN_EXE_sc-soc-sim")) else {
         return;
     };
     let sequence = Sequence::builtin(

@@ -3,7 +3,7 @@
 // `virt` machine, so that the firmware ELF QEMU runs runs here unchanged, and it is started
 // and spoken to as the host's QEMU link starts and speaks to QEMU:
 //
-//   sc_soc_sim --elf ELF --uart SOCKET [--load FILE@ADDR]... [--frames FILE]
+//   sc-soc-sim --elf ELF --uart SOCKET [--load FILE@ADDR]... [--frames FILE]
 //              [--ram-mib N] [--max-cycles N] [--watchdog-cycles N]
 //              [--pixel-clock-divider N] [--line-blank N]
 //
@@ -318,7 +318,7 @@ Args parse(int argc, char **argv) {
 
 }  // namespace
 
-int main(int argc, char **argv) {
+extern "C" int sc_soc_sim_main(int argc, char **argv) {
     Args args = parse(argc, argv);
     Ram ram;
     ram.bytes.assign(size_t(args.ram_mib) << 20, 0);

@@ -102,13 +102,14 @@ pub struct QemuConfig {
     pub elf: PathBuf,
     /// Run with `-icount shift=0` and have the firmware log every image's instruction counts.
     pub count_instructions: bool,
-    /// Run the ELF on the SoC in the loop instead of QEMU: the simulator `sc_soc_sim` that
-    /// `bash hdl-interface/soc/build.sh DIR` builds (a real RV32IMAC core, VexRiscv, and both
-    /// channels' `sc_fabric` on its bus, under Verilator, with the `virt` machine's RAM, UART
-    /// and finisher). It takes the same ELF and frame file and speaks on the same kind of
-    /// socket; the frame file says the cameras are wired (`FLAG_WIRED_CAMERAS`), so the
-    /// firmware drives the real fabric and the harness's cameras send the images. Its
-    /// `minstret` counts retired instructions without `-icount`.
+    /// Run the ELF on the SoC in the loop instead of QEMU: the simulator that `cargo build
+    /// --release -p stereocal-hil --bin sc-soc-sim` builds as `target/release/sc-soc-sim` (a
+    /// real RV32IMAC core, VexRiscv, and both channels' `sc_fabric` on its bus, under
+    /// Verilator, with the `virt` machine's RAM, UART and finisher). It takes the same ELF
+    /// and frame file and speaks on the same kind of socket; the frame file says the cameras
+    /// are wired (`FLAG_WIRED_CAMERAS`), so the firmware drives the real fabric and the
+    /// harness's cameras send the images. Its `minstret` counts retired instructions without
+    /// `-icount`.
     pub soc: Option<PathBuf>,
     /// On the SoC: the cameras' pixel clock, one clock in this many; `None` keeps the board's
     /// default (64, the stream engine's pace).
