@@ -47,8 +47,8 @@ pub struct HilArgs {
     /// and both channels' fabric RTL under Verilator. Without a path, the simulator
     /// `sc-soc-sim` next to this program or on PATH (`cargo build --release -p
     /// stereocal-hil --bin sc-soc-sim`).
-    #[arg(long, value_name = "SC_SOC_SIM", num_args = 0..=1, default_missing_value = "")]
-    soc: Option<PathBuf>,
+    #[arg(long, value_name = "SC_SOC_SIM", num_args = 0..=1)]
+    soc: Option<Option<PathBuf>>,
     /// On the SoC: the cameras' pixel clock, one clock in N (the board's default is 64, the
     /// stream engine's pace; 1 is a pixel every clock).
     #[arg(long, requires = "soc", value_parser = clap::value_parser!(u32).range(1..=4096))]
@@ -85,7 +85,11 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
     args.size.apply(&mut config);
     let sequence = Sequence::builtin(args.scene, config)
         .with_context(|| format!("cannot build the `{}` sequence", args.scene))?;
-    let soc = args.soc.as_deref().map(soc_simulator).transpose()?;
+    let soc = args
+        .soc
+        .as_ref()
+        .map(|given| soc_simulator(given.as_deref()))
+        .transpose()?;
     let defaults = if soc.is_some() {
         QemuTimeouts::soc()
     } else {
@@ -207,8 +211,8 @@ const SOC_SIMULATOR: &str = "sc-soc-sim";
 
 /// The simulator `--soc` names: the given path, or without one `sc-soc-sim` next to this
 /// program (both in cargo's target directory) or on PATH.
-fn soc_simulator(given: &Path) -> anyhow::Result<PathBuf> {
-    if !given.as_os_str().is_empty() {
+fn soc_simulator(given: Option<&Path>) -> anyhow::Result<PathBuf> {
+    if let Some(given) = given {
         return Ok(given.to_path_buf());
     }
     let beside = std::env::current_exe()
@@ -336,9 +340,30 @@ fn softcore_instructions_per_pair(logs: &[stereocal_tools::hil::DeviceLog]) -> O
 
 #[cfg(test)]
 mod tests {
+    use clap::Parser;
     use stereocal_tools::hil::DeviceLog;
 
-    use super::softcore_instructions_per_pair;
+    use super::{softcore_instructions_per_pair, HilArgs};
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        hil: HilArgs,
+    }
+
+    #[test]
+    fn soc_takes_an_optional_path() {
+        let soc = |args: &[&str]| {
+            Cli::try_parse_from([&["stereocal", "--elf", "e"], args].concat())
+                .unwrap()
+                .hil
+                .soc
+        };
+        assert_eq!(soc(&[]), None);
+        assert_eq!(soc(&["--soc", "--width", "128"]), Some(None));
+        assert_eq!(soc(&["--soc"]), Some(None));
+        assert_eq!(soc(&["--soc", "sim"]), Some(Some("sim".into())));
+    }
 
     fn report(frame: u32, camera: u8, driver: u64) -> DeviceLog {
         DeviceLog {
