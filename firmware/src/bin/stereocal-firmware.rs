@@ -266,13 +266,13 @@ mod soft_core {
                 let spent = instructions::instret().wrapping_sub(start);
                 let cycles = riscv::register::mcycle::read64().wrapping_sub(start_cycle);
                 if let (Ok(summary), true) = (&result, wired) {
+                    let waited = channel.bus_mut().take_wait_cycles();
                     let report = ImageReport {
                         frame: summary.frame_id,
                         camera: camera as u8,
-                        softcore_cycles: u32::try_from(
-                            cycles.wrapping_sub(channel.bus_mut().take_wait_cycles()),
-                        )
-                        .unwrap_or(u32::MAX),
+                        softcore_cycles: u32::try_from(cycles.wrapping_sub(waited))
+                            .unwrap_or(u32::MAX),
+                        busy_wait_cycles: u32::try_from(waited).unwrap_or(u32::MAX),
                         point_overflows: summary.overflow.points,
                         sobel_overflows: summary.overflow.sobel,
                     };

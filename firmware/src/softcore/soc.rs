@@ -2,13 +2,13 @@
 //! bus, and a report port for what the soft-core measured of each image, handed to the board
 //! rather than the link, so that the link's bytes stay those of every other device.
 //!
-//! The board (`hdl-interface/soc/sim/sc_soc_sim.cpp`) has five write-only word registers at
+//! The board (`hdl-interface/soc/sim/sc_soc_sim.cpp`) has six write-only word registers at
 //! [`REPORT_PORT`], the fabric's base address plus two channel strides: FRAME, CAMERA,
-//! POINT_OVERFLOWS, SOBEL_OVERFLOWS and CYCLES. A write of CYCLES completes a record, and
-//! the board prints it on its stderr as
+//! POINT_OVERFLOWS, SOBEL_OVERFLOWS, BUSY_WAIT_CYCLES and CYCLES. A write of CYCLES completes
+//! a record, and the board prints it on its stderr as
 //!
 //! ```text
-//! sc_soc_sim: image frame 3 camera 1 softcore_cycles 41234 point_overflows 0 sobel_overflows 0
+//! sc_soc_sim: image frame 3 camera 1 softcore_cycles 4123 busy_wait_cycles 20634573 point_overflows 0 sobel_overflows 0
 //! ```
 //!
 //! which the host reads back ([`ImageReport::parse`]). QEMU's `virt` has nothing there; the
@@ -34,6 +34,9 @@ pub struct ImageReport {
     /// spent polling STATUS.BUSY while the camera and the fabric did the frame: the program's
     /// own work, which the budget of a real head's soft-core is about.
     pub softcore_cycles: u32,
+    /// The cycles the driver spent polling STATUS.BUSY while the camera sent the image and
+    /// the fabric finished it: time a real head's core has for other work.
+    pub busy_wait_cycles: u32,
     /// Points the fabric's point FIFO dropped in the frame (POINT_OVERFLOW_COUNT's growth).
     pub point_overflows: u32,
     /// Sobel entries the fabric's Sobel FIFO dropped (SOBEL_OVERFLOW_COUNT's growth).
@@ -47,15 +50,17 @@ impl ImageReport {
             "frame",
             "camera",
             "softcore_cycles",
+            "busy_wait_cycles",
             "point_overflows",
             "sobel_overflows",
         ];
         let rest = line.strip_prefix("sc_soc_sim: ")?;
-        let [frame, camera, cycles, points, sobel] = fields(rest, "image", names)?;
+        let [frame, camera, cycles, waited, points, sobel] = fields(rest, "image", names)?;
         Some(Self {
             frame: u32::try_from(frame).ok()?,
             camera: u8::try_from(camera).ok()?,
             softcore_cycles: u32::try_from(cycles).ok()?,
+            busy_wait_cycles: u32::try_from(waited).ok()?,
             point_overflows: u32::try_from(points).ok()?,
             sobel_overflows: u32::try_from(sobel).ok()?,
         })
@@ -72,6 +77,7 @@ impl ImageReport {
             self.camera.into(),
             self.point_overflows,
             self.sobel_overflows,
+            self.busy_wait_cycles,
             self.softcore_cycles,
         ];
         for (i, word) in words.into_iter().enumerate() {
@@ -87,14 +93,15 @@ mod tests {
 
     #[test]
     fn a_board_line_reads_back() {
-        let line = "sc_soc_sim: image frame 3 camera 1 softcore_cycles 41234 point_overflows 2 \
-                    sobel_overflows 0";
+        let line = "sc_soc_sim: image frame 3 camera 1 softcore_cycles 41234 busy_wait_cycles 7 \
+                    point_overflows 2 sobel_overflows 0";
         assert_eq!(
             ImageReport::parse(line),
             Some(ImageReport {
                 frame: 3,
                 camera: 1,
                 softcore_cycles: 41234,
+                busy_wait_cycles: 7,
                 point_overflows: 2,
                 sobel_overflows: 0,
             })

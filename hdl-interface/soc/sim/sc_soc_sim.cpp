@@ -19,20 +19,25 @@
 //   bus error (the core takes an access fault).
 // - The cameras (--frames, the frame-grabber file whose layout is the firmware's
 //   softcore/frame_input.rs): camera c sends the file's images of camera c in order. A
-//   camera is triggered: it starts an image on the first pixel clock its fabric's PIXEL_IN
-//   is ready (the fabric armed, waiting for SOF), then sends one pixel per pixel clock, each
-//   line followed by --line-blank pixel clocks (default 16), and never waits: a pixel the
-//   fabric does not take ends the run with status 125 and a message. A pixel clock is one
-//   clock in --pixel-clock-divider (default 64; the stream engine's pace, docs/
-//   STREAM_ENGINE.md).
+//   camera is triggered, as a global-shutter sensor in snapshot mode is: it starts an image
+//   on the first pixel clock its fabric's PIXEL_IN is ready (the fabric armed, waiting for
+//   SOF), so its frame blanking is the time until the driver arms the next frame; then it
+//   sends one pixel per pixel clock, each line followed by --line-blank pixel clocks, and
+//   never waits: a pixel the fabric does not take ends the run with status 125 and a
+//   message. The default line blanking, 16 pixel clocks, is shorter than a real sensor's
+//   (VGA timing has 160, an MT9V034 at least 61): the fabric's work at a line's end must fit
+//   in it, so the shortest is the hardest case. A pixel clock is one clock in
+//   --pixel-clock-divider (default 64: the stream engine's pace, docs/STREAM_ENGINE.md; at 1
+//   the engine falls behind and the frame stops with STREAM_FAULT.OVERRUN).
 // - The link: the UART's bytes and both LINK_OUT ports share the socket at link-frame
 //   boundaries: a source that has begun a frame keeps the socket until its 0x00 delimiter,
 //   the others' bytes wait (a link arbiter; LINK_OUT is always ready).
-// - The report port at 0x4002_0000 (firmware softcore/soc.rs): five write-only words FRAME,
-//   CAMERA, POINT_OVERFLOWS, SOBEL_OVERFLOWS, CYCLES; a write of CYCLES prints the record as
-//   `sc_soc_sim: image frame F camera C softcore_cycles N point_overflows P sobel_overflows S`.
+// - The report port at 0x4002_0000 (firmware softcore/soc.rs): six write-only words FRAME,
+//   CAMERA, POINT_OVERFLOWS, SOBEL_OVERFLOWS, BUSY_WAIT_CYCLES, CYCLES; a write of CYCLES
+//   prints the record as `sc_soc_sim: image frame F camera C softcore_cycles N
+//   busy_wait_cycles N point_overflows P sobel_overflows S`.
 // - --max-cycles (default: none) ends a run that did not finish with exit status 124 and a
-//   message naming the limit; the host side reports it as a timeout.
+//   message naming the limit; the host reports the status and the message.
 // - The watchdog: a run in which nothing moves for --watchdog-cycles clocks (default
 //   400,000; 0 turns it off) ends with exit status 124 and a message saying what stood
 //   still and where the core last fetched. Moving is a camera pixel taken or a byte on the
@@ -74,11 +79,14 @@ constexpr uint32_t RAM_BASE = 0x80000000u;
 constexpr uint32_t UART_BASE = 0x10000000u;
 constexpr uint32_t FINISHER = 0x00100000u;
 constexpr uint32_t REPORT_PORT = 0x40020000u;
-constexpr uint32_t REPORT_WORDS = 5;   // FRAME, CAMERA, POINT_OVERFLOWS, SOBEL_OVERFLOWS, CYCLES
+// FRAME, CAMERA, POINT_OVERFLOWS, SOBEL_OVERFLOWS, BUSY_WAIT_CYCLES, CYCLES
+constexpr uint32_t REPORT_WORDS = 6;
 
+/// A board that cannot run (bad arguments, a file it cannot read) ends with status 64
+/// (EX_USAGE), which no firmware exit code is: the host must not read it as the firmware's.
 [[noreturn]] void die(const std::string &what) {
     std::fprintf(stderr, "sc_soc_sim: %s\n", what.c_str());
-    std::exit(2);
+    std::exit(64);
 }
 
 std::vector<uint8_t> read_file(const std::string &path) {
@@ -342,8 +350,9 @@ extern "C" int sc_soc_sim_main(int argc, char **argv) {
         uint32_t count;
         std::memcpy(&count, &frames[12], 4);
         size_t record = 8 + size_t(width) * height, off = 16;
-        if (cameras < 1 || cameras > 2 || off + record * cameras * count > frames.size())
-            die(args.frames + ": truncated or not 1 or 2 cameras");
+        if (cameras < 1 || cameras > 2 || width == 0 || height == 0 ||
+            off + record * cameras * count > frames.size())
+            die(args.frames + ": truncated, an empty image or not 1 or 2 cameras");
         for (uint32_t f = 0; f < count; f++)
             for (uint32_t c = 0; c < cameras; c++, off += record)
                 cams[c].images.push_back(&frames[off + 8]);
@@ -472,8 +481,9 @@ extern "C" int sc_soc_sim_main(int argc, char **argv) {
                 if (top.dbus_we) report[word] = wdata;
                 if (top.dbus_we && word == REPORT_WORDS - 1)
                     std::fprintf(stderr, "sc_soc_sim: image frame %u camera %u softcore_cycles %u "
-                                 "point_overflows %u sobel_overflows %u\n",
-                                 report[0], report[1], report[4], report[2], report[3]);
+                                 "busy_wait_cycles %u point_overflows %u sobel_overflows %u\n",
+                                 report[0], report[1], report[5], report[4], report[2],
+                                 report[3]);
                 top.dbus_dat_r = 0;
                 top.dbus_ack = 1;
             } else {

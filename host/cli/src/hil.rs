@@ -20,10 +20,11 @@ use crate::output::{finish, progress_bar, Finish};
 
 #[derive(Debug, Clone, Args)]
 pub struct HilArgs {
-    /// The firmware ELF (build it with `cargo build --release -p stereocal-firmware
-    /// --target riscv32imc-unknown-none-elf`).
+    /// The firmware ELF (default: the release build beside this program's target directory,
+    /// `target/riscv32imc-unknown-none-elf/release/stereocal-firmware`, which `cargo build
+    /// --release -p stereocal-firmware --target riscv32imc-unknown-none-elf` makes).
     #[arg(long)]
-    elf: PathBuf,
+    elf: Option<PathBuf>,
     /// Built-in scene: road, lab or sparse.
     #[arg(long, default_value = "road")]
     scene: SceneKind,
@@ -85,6 +86,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
     args.size.apply(&mut config);
     let sequence = Sequence::builtin(args.scene, config)
         .with_context(|| format!("cannot build the `{}` sequence", args.scene))?;
+    let elf = firmware_elf(args.elf.as_deref())?;
     let soc = args
         .soc
         .as_ref()
@@ -104,7 +106,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
             answer: args.timeout.map_or(defaults.answer, Duration::from_secs),
             ..defaults
         },
-        ..QemuConfig::new(&args.elf)
+        ..QemuConfig::new(&elf)
     };
 
     let machine = if soc.is_some() {
@@ -124,7 +126,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
         device: run,
         wire,
         records_identical,
-    } = run.with_context(|| format!("hardware-in-the-loop run of {}", args.elf.display()))?;
+    } = run.with_context(|| format!("hardware-in-the-loop run of {}", elf.display()))?;
     if args.verbose {
         if run.logs.is_empty() {
             eprintln!("firmware: no log messages");
@@ -206,6 +208,28 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
     )
 }
 
+/// The firmware's release ELF, relative to cargo's target directory.
+const FIRMWARE_ELF: &str = "riscv32imc-unknown-none-elf/release/stereocal-firmware";
+
+/// The ELF `--elf` names, or without it the release build in the target directory this
+/// program was built into (`target/release/stereocal` → `target/FIRMWARE_ELF`).
+fn firmware_elf(given: Option<&Path>) -> anyhow::Result<PathBuf> {
+    if let Some(given) = given {
+        return Ok(given.to_path_buf());
+    }
+    std::env::current_exe()
+        .ok()
+        .and_then(|exe| Some(exe.parent()?.parent()?.join(FIRMWARE_ELF)))
+        .filter(|elf| elf.is_file())
+        .with_context(|| {
+            format!(
+                "no firmware ELF beside this program's target directory ({FIRMWARE_ELF}): \
+                 build it with `cargo build --release -p stereocal-firmware --target \
+                 riscv32imc-unknown-none-elf`, or give its path as --elf PATH"
+            )
+        })
+}
+
 /// The SoC simulator's name, as `cargo build -p stereocal-hil --bin sc-soc-sim` builds it.
 const SOC_SIMULATOR: &str = "sc-soc-sim";
 
@@ -243,9 +267,10 @@ fn board_figures(board: &SocReport, json: &mut serde_json::Map<String, serde_jso
     let latency = board.latency();
     let speed = board.clocks_per_second();
     eprintln!(
-        "SoC: soft-core cycles per pair (its own work, BUSY polling excluded) {}, simulated \
-         clocks per pair {}, FIFO overflows {}",
+        "SoC: soft-core cycles per pair: its own work {}, polling BUSY {}; simulated clocks \
+         per pair {}, FIFO overflows {}",
         show(cycles),
+        show(board.busy_wait_cycles_per_pair()),
         show(clocks),
         board.fifo_overflows()
     );
@@ -265,6 +290,10 @@ fn board_figures(board: &SocReport, json: &mut serde_json::Map<String, serde_jso
         );
     }
     json.insert("softcore_cycles_per_pair".into(), cycles.into());
+    json.insert(
+        "softcore_busy_wait_cycles_per_pair".into(),
+        board.busy_wait_cycles_per_pair().into(),
+    );
     json.insert("sim_clocks_per_pair".into(), clocks.into());
     json.insert("fifo_overflows".into(), board.fifo_overflows().into());
     json.insert(
@@ -354,7 +383,7 @@ mod tests {
     #[test]
     fn soc_takes_an_optional_path() {
         let soc = |args: &[&str]| {
-            Cli::try_parse_from([&["stereocal", "--elf", "e"], args].concat())
+            Cli::try_parse_from([&["stereocal"], args].concat())
                 .unwrap()
                 .hil
                 .soc

@@ -7,7 +7,8 @@
 //! harness's `sc_soc_sim_main`.
 //!
 //! Built where the model could not be (no `verilator`, no python3 with venv or no network
-//! for the core's first fetch), the binary says why on stderr and exits with status 2.
+//! for the core's first fetch), the binary says why on stderr and exits with status 64, the
+//! harness's status for a board that cannot run (no firmware exit code is 64).
 
 #[cfg(soc_sim)]
 use std::ffi::{c_char, c_int, CString};
@@ -50,5 +51,5 @@ fn main() {
          needs python3 with venv and network for pip)",
         env!("STEREOCAL_SOC_SKIP")
     );
-    std::process::exit(2);
+    std::process::exit(64);
 }

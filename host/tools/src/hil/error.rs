@@ -14,7 +14,7 @@ use stereocal::link::LinkError;
 /// The timeouts of a run, by name: an error says which one fired.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TimeoutKind {
-    /// QEMU to open its UART socket after it was started.
+    /// The machine to open its UART socket after it was started.
     Startup,
     /// The device to answer one request (Hello, a register read) or deliver one frame pair.
     Answer,
@@ -40,14 +40,16 @@ impl fmt::Display for TimeoutKind {
 pub enum FirmwareExit {
     /// One of the firmware's own codes.
     Code(ExitCode),
-    /// Another status: QEMU itself failed (bad arguments, a missing file).
+    /// Another status: the machine itself stopped the run (QEMU's bad arguments or missing
+    /// files; the SoC's board: 64 it cannot run, 124 its watchdog or cycle limit, 125 a
+    /// camera's pixel not taken).
     Other(i32),
-    /// QEMU was killed by a signal (by this runner after an error, or from outside).
+    /// The machine was killed by a signal (by this runner after an error, or from outside).
     Signal,
 }
 
 impl FirmwareExit {
-    /// Reads QEMU's exit status.
+    /// Reads the machine's exit status.
     pub fn from_status(status: ExitStatus) -> Self {
         const CODES: [ExitCode; 5] = [
             ExitCode::Success,
@@ -97,10 +99,13 @@ impl fmt::Display for FirmwareExit {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum HilError {
-    /// The emulator could not be started.
-    #[error("cannot start {program} (is qemu-system-misc installed?): {source}")]
+    /// The machine could not be started.
+    #[error(
+        "cannot start {program} (QEMU: is qemu-system-misc installed? the SoC: `cargo build \
+         --release -p stereocal-hil --bin sc-soc-sim`): {source}"
+    )]
     Spawn {
-        /// The QEMU binary.
+        /// The QEMU binary or the SoC simulator.
         program: PathBuf,
         /// The operating system's reason.
         #[source]
@@ -168,12 +173,12 @@ pub enum HilError {
         /// What the firmware had logged (decoded), one message a line.
         log: String,
     },
-    /// QEMU ended before the run did.
+    /// The machine ended before the run did.
     #[error("the machine ended early, {exit}{}", stderr_suffix(stderr))]
     EndedEarly {
         /// How it ended.
         exit: FirmwareExit,
-        /// What QEMU printed on stderr.
+        /// What the machine printed on stderr.
         stderr: String,
     },
     /// The firmware ran to its end but did not report success.
@@ -187,10 +192,10 @@ pub enum HilError {
     /// The run could not be prepared (rendering, calibration, image size).
     #[error(transparent)]
     Eval(Box<EvalError>),
-    /// The link to QEMU failed while the run was ending.
+    /// The link to the machine failed while the run was ending.
     #[error(transparent)]
     Link(#[from] LinkError),
-    /// The session on the emulated device failed; QEMU was stopped.
+    /// The session on the device failed; the machine was stopped.
     #[error(
         "{source}; the machine: {exit}{}{}",
         stderr_suffix(stderr),
@@ -200,9 +205,9 @@ pub enum HilError {
         /// What failed (boxed: the session's errors are large and this one is rare).
         #[source]
         source: Box<EvalError>,
-        /// How QEMU ended (`killed by a signal` when the runner had to kill it).
+        /// How the machine ended (`killed by a signal` when the runner had to kill it).
         exit: FirmwareExit,
-        /// What QEMU printed on stderr.
+        /// What the machine printed on stderr.
         stderr: String,
         /// What the firmware logged (decoded), one message a line.
         log: String,

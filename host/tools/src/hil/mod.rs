@@ -1,13 +1,17 @@
-//! Hardware in the loop: the firmware ELF on an emulated RISC-V soft-core (QEMU `virt`),
-//! speaking the wire format to the same host driver, session and estimator as the in-process
-//! device.
+//! Hardware in the loop: the firmware ELF on an emulated RISC-V soft-core (QEMU `virt`) or
+//! on the SoC in the loop (a real core and the fabric's RTL under Verilator, the binary
+//! `sc-soc-sim`, which takes QEMU's place: [`QemuConfig::soc`]), speaking the wire format to
+//! the same host driver, session and estimator as the in-process device. The types keep
+//! QEMU's name: the SoC's board is started and spoken to exactly as QEMU is.
 //!
 //! The frames go into the soft-core's frame-grabber region before it boots ([`GrabberInput`];
-//! the emulated UART is far too slow for pixels); the configuration, the packets and the
-//! firmware's defmt logs go over the UART, which QEMU puts on a Unix socket
-//! ([`QemuDevice`]). [`run_on_qemu`] runs any session on it and stops QEMU on every path;
-//! [`run_sequence`] is `stereocal hil`. The `stereocal-hil` tests check that the UART bytes
-//! are the in-process device's bytes and the estimates the same numbers.
+//! the UART is far too slow for pixels); the configuration, the packets and the firmware's
+//! defmt logs go over the UART, which the machine puts on a Unix socket ([`QemuDevice`]).
+//! [`run_on_qemu`] runs any session on it and stops the machine on every path;
+//! [`run_sequence`] is `stereocal hil`, with the in-process comparison
+//! ([`compare_streams`]); [`SocReport`] reads what the SoC's board measured. The
+//! `stereocal-hil` tests check that the bytes are the in-process device's bytes and the
+//! estimates the same numbers.
 
 mod device_log;
 mod error;

@@ -1,5 +1,5 @@
-//! A run on the emulated soft-core from start to end: QEMU started with the frames, a session
-//! on it, QEMU stopped, and every failure named.
+//! A run on the soft-core from start to end: the machine (QEMU or the SoC's board) started
+//! with the frames, a session on it, the machine stopped, and every failure named.
 
 use rayon::prelude::*;
 
@@ -15,12 +15,12 @@ use stereocal::output::record::FrameRecord;
 use stereocal::session::{Session, SessionConfig, SessionCost, SessionError};
 use stereocal_synth::Sequence;
 
-/// What a run on QEMU gave.
+/// What a run on the machine gave.
 #[derive(Debug)]
 pub struct QemuRun<T> {
     /// What the session computed.
     pub value: T,
-    /// How QEMU ended (success: every frame ran) and every byte the firmware sent.
+    /// How the machine ended (success: every frame ran) and every byte the firmware sent.
     pub end: QemuEnd,
     /// The firmware's logs, decoded with the ELF's defmt table.
     pub logs: Vec<DeviceLog>,
@@ -37,14 +37,14 @@ pub struct SequenceRun {
     /// Whether the device's bytes after its `Hello` were the in-process device's; `None` when
     /// the firmware counted instructions (its reports are extra `Log` packets on the link).
     pub wire: Option<Result<(), StreamMismatch>>,
-    /// Whether the host's records of both runs are equal, every float to the bit.
+    /// Whether the host's records of both runs are equal, field by field (floats by `==`).
     pub records_identical: bool,
 }
 
-/// Starts QEMU on `config.elf` with `input` in its frame region, runs `session` on the
-/// device, and ends QEMU: when `session` succeeds, by reading the UART to its end and
+/// Starts the machine on `config.elf` with `input` in its frame region, runs `session` on the
+/// device, and ends the machine: when `session` succeeds, by reading the UART to its end and
 /// requiring the firmware's success exit; otherwise by stopping it (see
-/// [`QemuDevice::abort`]) and returning the failure with QEMU's status and the firmware's
+/// [`QemuDevice::abort`]) and returning the failure with the machine's status and the firmware's
 /// logs. An answer timeout inside the session is reported as [`HilError::Timeout`].
 pub fn run_on_qemu<T>(
     config: &QemuConfig,
@@ -104,7 +104,7 @@ pub fn run_on_qemu<T>(
     }
 }
 
-/// `stereocal hil`: every frame of `sequence` through the firmware under QEMU, then the host
+/// `stereocal hil`: every frame of `sequence` through the firmware on the machine, then the host
 /// chain exactly as `eval` runs it on the in-process device; `progress` is called after each
 /// frame. Then the same frames on the in-process device, whose bytes and records the device's
 /// are compared with.
@@ -116,7 +116,7 @@ pub fn run_sequence(
 ) -> Result<SequenceRun, HilError> {
     let calib = sequence_calibration(sequence).map_err(EvalError::from)?;
     let (width, height) = fabric_size(sequence)?;
-    // QEMU needs every pair before it boots, so the whole sequence is rendered first.
+    // The machine needs every pair before it boots, so the whole sequence is rendered first.
     let frames = (0..sequence.len())
         .into_par_iter()
         .map(|index| sequence.frame(index))

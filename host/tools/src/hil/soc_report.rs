@@ -90,6 +90,19 @@ impl SocReport {
         per_frame.into_values().max()
     }
 
+    /// The cycles the soft-core polled STATUS.BUSY in the pair of
+    /// [`Self::softcore_cycles_per_pair`], its own work plus these being its whole `mcycle`
+    /// across the pair's driver calls.
+    pub fn busy_wait_cycles_per_pair(&self) -> Option<u64> {
+        let mut per_frame = BTreeMap::<u32, (u64, u64)>::new();
+        for r in &self.images {
+            let entry = per_frame.entry(r.frame).or_default();
+            entry.0 += u64::from(r.softcore_cycles);
+            entry.1 += u64::from(r.busy_wait_cycles);
+        }
+        per_frame.into_values().max().map(|(_, waited)| waited)
+    }
+
     /// Points and Sobel entries the fabrics' FIFOs dropped over the run.
     pub fn fifo_overflows(&self) -> u64 {
         self.images
@@ -111,13 +124,17 @@ impl SocReport {
             .collect();
         starts.sort_unstable();
         starts.push(end);
-        starts.windows(2).map(|w| w[1] - w[0]).max()
+        // The board's numbers are data: a malformed line may put the end before a start.
+        starts.windows(2).map(|w| w[1].saturating_sub(w[0])).max()
     }
 
     /// The worst image's latency; `None` when no image sent a byte.
     pub fn latency(&self) -> Option<Latency> {
         let sent = self.timings.iter().filter(|t| t.last_byte >= t.first_pixel);
-        let first = sent.clone().map(|t| t.last_byte - t.first_pixel).max()?;
+        let first = sent
+            .clone()
+            .map(|t| t.last_byte.saturating_sub(t.first_pixel))
+            .max()?;
         let last = sent
             .map(|t| t.last_byte.saturating_sub(t.last_pixel))
             .max()?;
@@ -182,10 +199,10 @@ mod tests {
     use super::*;
 
     const STDERR: &str = "\
-sc_soc_sim: image frame 0 camera 0 softcore_cycles 900 point_overflows 1 sobel_overflows 0
-sc_soc_sim: image frame 0 camera 1 softcore_cycles 800 point_overflows 0 sobel_overflows 2
-sc_soc_sim: image frame 1 camera 0 softcore_cycles 1000 point_overflows 0 sobel_overflows 0
-sc_soc_sim: image frame 1 camera 1 softcore_cycles 1000 point_overflows 0 sobel_overflows 0
+sc_soc_sim: image frame 0 camera 0 softcore_cycles 900 busy_wait_cycles 10 point_overflows 1 sobel_overflows 0
+sc_soc_sim: image frame 0 camera 1 softcore_cycles 800 busy_wait_cycles 20 point_overflows 0 sobel_overflows 2
+sc_soc_sim: image frame 1 camera 0 softcore_cycles 1000 busy_wait_cycles 40 point_overflows 0 sobel_overflows 0
+sc_soc_sim: image frame 1 camera 1 softcore_cycles 1000 busy_wait_cycles 50 point_overflows 0 sobel_overflows 0
 some other line
 sc_soc_sim: timing camera 0 image 0 first_pixel 100 last_pixel 1100 first_byte 300 last_byte 1500
 sc_soc_sim: timing camera 0 image 1 first_pixel 5000 last_pixel 6000 first_byte 5200 last_byte 6100
@@ -199,6 +216,7 @@ sc_soc_sim: cycles 9000 millis 3 fabric_reads 10 fabric_writes 4 longest_still 7
         assert_eq!(r.images.len(), 4);
         assert_eq!(r.timings.len(), 3);
         assert_eq!(r.softcore_cycles_per_pair(), Some(2000));
+        assert_eq!(r.busy_wait_cycles_per_pair(), Some(90));
         assert_eq!(r.fifo_overflows(), 3);
         // Pairs start at 100 and 5000; the run ends at 9000.
         assert_eq!(r.sim_clocks_per_pair(), Some(4900));
