@@ -276,9 +276,9 @@ struct Args {
     std::vector<std::pair<std::string, uint32_t>> loads;
     uint64_t ram_mib = 128;
     uint64_t max_cycles = 0;
-    // Ten times the longest stillness of a healthy 640x480 pair (40,123 clocks: the stream
-    // engine's end-of-frame passes; `stereocal hil --soc --width 640 --height 480 --json`,
-    // sim_longest_still_clocks), a few seconds of simulation.
+    // About ten times the longest stillness of a healthy 640x240 or 640x480 pair (40,125
+    // clocks: the stream engine's end-of-frame passes; `stereocal hil --soc --width 640
+    // --height 480 --json`, sim_longest_still_clocks), a few seconds of simulation.
     uint64_t watchdog = 400000;
 };
 
