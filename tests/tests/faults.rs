@@ -62,7 +62,7 @@ fn patched(elf: &Path, part: &str, word: u32) -> tempfile::NamedTempFile {
 }
 
 /// Runs four 128x96 pairs on `config` with `word` patched in; the error and the wall time.
-fn run_faulty(config: &QemuConfig, word: u32) -> (HilError, Duration, tempfile::NamedTempFile) {
+fn run_faulty(config: &QemuConfig, word: u32) -> (HilError, Duration) {
     let elf = patched(&config.elf, target(config), word);
     let config = QemuConfig {
         elf: elf.path().to_path_buf(),
@@ -71,7 +71,7 @@ fn run_faulty(config: &QemuConfig, word: u32) -> (HilError, Duration, tempfile::
     let scenario = Scenario::synthetic(SceneKind::Road, 128, 96, 4, SessionConfig::default());
     let start = Instant::now();
     let err = run_qemu(&scenario, &config).expect_err("the patched firmware cannot succeed");
-    (err, start.elapsed(), elf)
+    (err, start.elapsed())
 }
 
 fn assert_trap_named(test: &str, err: &HilError, took: Duration) {
@@ -97,7 +97,7 @@ fn qemu_hung_firmware_ends_the_run_once_on_its_silence() {
         return;
     };
     qemu.timeouts.silence = Duration::from_secs(3);
-    let (err, took, _elf) = run_faulty(&qemu, HANG);
+    let (err, took) = run_faulty(&qemu, HANG);
     assert!(
         matches!(
             err,
@@ -123,7 +123,7 @@ fn qemu_trap_ends_the_run_at_once_with_the_cause() {
     let Some(qemu) = qemu_or_skip(test) else {
         return;
     };
-    let (err, took, _elf) = run_faulty(&qemu, ECALL);
+    let (err, took) = run_faulty(&qemu, ECALL);
     assert_trap_named(test, &err, took);
 }
 
@@ -138,7 +138,7 @@ fn soc_hung_firmware_is_ended_by_the_board_watchdog() {
         QemuTimeouts::soc(),
         "{test}: the board's watchdog must be first"
     );
-    let (err, took, _elf) = run_faulty(&soc, HANG);
+    let (err, took) = run_faulty(&soc, HANG);
     match &err {
         HilError::Device { exit, stderr, .. } => {
             assert_eq!(*exit, FirmwareExit::Other(124), "{test}: {err}");
@@ -157,6 +157,6 @@ fn soc_trap_ends_the_run_at_once_with_the_cause() {
     let Some(soc) = soc_or_skip(test, env!("CARGO_BIN_EXE_sc-soc-sim")) else {
         return;
     };
-    let (err, took, _elf) = run_faulty(&soc, ECALL);
+    let (err, took) = run_faulty(&soc, ECALL);
     assert_trap_named(test, &err, took);
 }

@@ -83,24 +83,26 @@ impl SocReport {
     /// The soft-core's own cycles for the costliest frame pair: both cameras' reports of a
     /// frame added (the budget is per pair, so the worst pair is the figure).
     pub fn softcore_cycles_per_pair(&self) -> Option<u64> {
-        let mut per_frame = BTreeMap::<u32, u64>::new();
-        for r in &self.images {
-            *per_frame.entry(r.frame).or_default() += u64::from(r.softcore_cycles);
-        }
-        per_frame.into_values().max()
+        self.costliest_pair().map(|(own, _)| own)
     }
 
     /// The cycles the soft-core polled STATUS.BUSY in the pair of
     /// [`Self::softcore_cycles_per_pair`], its own work plus these being its whole `mcycle`
     /// across the pair's driver calls.
     pub fn busy_wait_cycles_per_pair(&self) -> Option<u64> {
+        self.costliest_pair().map(|(_, waited)| waited)
+    }
+
+    /// The own and busy-wait cycles of the frame pair with the most own cycles, both
+    /// cameras' reports of a frame added.
+    fn costliest_pair(&self) -> Option<(u64, u64)> {
         let mut per_frame = BTreeMap::<u32, (u64, u64)>::new();
         for r in &self.images {
             let entry = per_frame.entry(r.frame).or_default();
             entry.0 += u64::from(r.softcore_cycles);
             entry.1 += u64::from(r.busy_wait_cycles);
         }
-        per_frame.into_values().max().map(|(_, waited)| waited)
+        per_frame.into_values().max()
     }
 
     /// Points and Sobel entries the fabrics' FIFOs dropped over the run.
