@@ -244,8 +244,10 @@ pub fn write_injected(
     fs::create_dir_all(parent).map_err(io(parent))?;
     let staging = StagingDir::new_in(parent).map_err(io(parent))?;
     let (ldir, rdir) = (staging.path().join("left"), staging.path().join("right"));
+    // `create_dir`, not `create_dir_all`: should Ctrl-C's handler have removed the staging
+    // directory meanwhile, this fails instead of making it again for the exit to leave behind.
     for d in [&ldir, &rdir] {
-        fs::create_dir_all(d).map_err(io(d))?;
+        fs::create_dir(d).map_err(io(d))?;
     }
     (0..frames).into_par_iter().try_for_each(|i| {
         let (al, ar) = yaws(motion, i, frames);

@@ -597,8 +597,11 @@ impl Sequence {
             move |source| SynthError::Io { path, source }
         };
         let (left, right) = (dir.join("left"), dir.join("right"));
+        // `create_dir`, not `create_dir_all`: should Ctrl-C's handler have removed the
+        // staging directory meanwhile, this fails instead of making it again for the exit to
+        // leave behind.
         for d in [&left, &right] {
-            fs::create_dir_all(d).map_err(io(d))?;
+            fs::create_dir(d).map_err(io(d))?;
         }
         (0..self.len()).into_par_iter().try_for_each(|i| {
             let frame = self.frame(i)?;
