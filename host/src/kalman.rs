@@ -72,12 +72,22 @@ impl Default for KalmanConfig {
         Self {
             // 0.01° of drift in 10 s.
             still_noise: 1e-5,
+            // Halving or doubling it moves the filtered median error of the rendered road by
+            // < 0.0001° and the KITTI drive's by < 0.002° (README, "Sensitivity of the constants").
             turning_noise: 100.0,
+            // Halving or doubling it moves the filtered median error of the rendered road by
+            // < 0.0001° and the KITTI drive's by < 0.001°.
             mode_time_s: 2.0,
+            // The output's resolution (hundredths of a degree): the estimator's σ counts only
+            // its matches' noise, and a frame is not trusted beyond what the output shows.
+            // Halving it raises the rendered road's filtered median error from 0.0009° to
+            // 0.0013°; doubling it moves that by < 0.0002° and the KITTI drive's by < 0.004°.
             min_measurement_sigma_deg: 0.01,
             // Above the 3-4 σ frames that the per-frame errors' heavy tails give every few
             // dozen frames (module doc): those are weighed by the models, not restarted from.
             gate_sigmas: 5.0,
+            // Only the start: the first frames fix the rate, and 5 or 20 °/s moves the filtered
+            // median error of the rendered road and the KITTI drive by < 0.00001°.
             initial_rate_sigma: 10.0,
             // The output's resolution (hundredths of a degree): a head whose joint angles are
             // worse than that (backlash, a commanded angle not yet reached) still predicts a

@@ -45,9 +45,21 @@ impl Default for SubpixelConfig {
             // A 15x15 window, the largest whose sums in `ncc_scan` stay exact in `f32`
             // (225 · 255² < 2^24 < 289 · 255²).
             half_window: 7,
+            // The inverse-compositional steps converge within a few iterations from a start
+            // inside the window; halving or doubling the bound moves the rendered road's raw
+            // median error by < 0.0002° and the KITTI drive's by < 0.008°
+            // (README, "Sensitivity of the constants").
             max_iterations: 12,
+            // Two pixels: the most a match between octave-1 keypoints starts from its true
+            // place (each lies within a pixel of its blob on that octave's 2 px grid). Halving
+            // or doubling it moves the rendered road's raw median error by < 0.0002° and the
+            // KITTI drive's by < 0.007°.
             max_shift_px: 2.0,
+            // Halving or doubling it moves the rendered road's raw median error by < 0.0001°
+            // and the KITTI drive's by < 0.002°.
             max_sigma_v_px: 0.15,
+            // 0.7 or 0.9 moves the rendered road's raw median error by < 0.0005° and the
+            // KITTI drive's by < 0.007°.
             min_correlation: 0.8,
         }
     }
@@ -607,7 +619,9 @@ pub fn guided_pair(
 }
 
 /// A guided match's correlation peak must beat any other peak by this much (ambiguity test,
-/// the analogue of the descriptor ratio test).
+/// the analogue of the descriptor ratio test). Halving or doubling it moves the rendered
+/// road's raw median error by < 0.0001° and the KITTI drive's by < 0.002°
+/// (README, "Sensitivity of the constants").
 const GUIDED_PEAK_MARGIN: f32 = 0.1;
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use stereocal::descriptor::DescriptorMode;
 use stereocal::estimator::Model;
 use stereocal::link::LinkProtection;
-use stereocal::matching::Gate;
+use stereocal::matching::{Gate, MatchConfig};
 use stereocal::misalignment::WindowConfig;
 use stereocal::session::SessionConfig;
 use stereocal_hdl::regs::output_mode::SobelOutput;
@@ -62,7 +62,7 @@ pub struct EstimateArgs {
     #[arg(long, overrides_with = "ransac")]
     no_ransac: bool,
     /// Lowe's ratio test: best distance < RATIO x second best, in (0, 1).
-    #[arg(long, default_value_t = 0.6, value_parser = parse_ratio)]
+    #[arg(long, default_value_t = MatchConfig::default().ratio, value_parser = parse_ratio)]
     ratio: f32,
     /// Keep only the N best matches (default: every match that passes the tests).
     #[arg(long, value_parser = parse_best)]

@@ -150,6 +150,13 @@ impl GeneralFit {
 /// Minimum matches for 5 unknowns.
 pub const GENERAL_MIN_MATCHES: usize = 5;
 
+/// Central-difference step of the Jacobians (radians, in the tangent space of the pose). E's
+/// entries are of unit scale, so the derivatives' rounding error is about ε/STEP ≈ 2e-9 of
+/// their size and the truncation error about STEP² = 1e-14: both far below what a
+/// Gauss-Newton step or the covariance needs (the optimum, ε^(1/3) ≈ 6e-6, gains nothing
+/// that matters). A step ten times smaller or larger moves the general model's median errors
+/// on the rendered road and the KITTI drive by < 0.00001° (README, "Sensitivity of the
+/// constants").
 const STEP: f64 = 1e-7;
 
 /// Robust Gauss-Newton (IRLS) refinement of the 5-DOF pose from `init` (typically the
@@ -204,6 +211,10 @@ pub fn refine(
         if !step.iter().all(|v| v.is_finite()) {
             return Err(EssentialError::Degenerate);
         }
+        // 1e-12 rad is 6e-11°, far below any accuracy that matters, and still thousands of
+        // times f64's rounding (ε ≈ 2.2e-16) of the unit-scale angles and direction it updates.
+        // 1e-13 or 1e-10 moves the general model's median errors on the rendered road and the
+        // KITTI drive by < 0.00001°.
         if step.norm() < 1e-12 {
             break;
         }

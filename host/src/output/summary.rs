@@ -7,7 +7,9 @@ use crate::output::record::{FrameRecord, FrameStatus};
 
 /// Frames the filter takes to settle after it starts from one raw measurement. Over them its
 /// σ falls from the measurement's towards its steady value; their spread is the start-up, not
-/// the stability the span measures.
+/// the stability the span measures. Eight: the still model's average of n frames has 1/√n of
+/// one frame's σ, a third at eight. Four or sixteen moves neither the rendered road's span
+/// nor the fixed KITTI drive's (README, "Sensitivity of the constants").
 pub const SETTLING_FRAMES: usize = 8;
 
 /// The first frame of a `frames`-frame run counted as settled: [`SETTLING_FRAMES`], or the
