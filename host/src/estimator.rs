@@ -9,7 +9,7 @@
 
 use std::sync::{Arc, Mutex, OnceLock};
 
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use stereocal_hdl::regs::MAX_OCTAVES;
 
@@ -100,8 +100,9 @@ pub struct EstimatorConfig {
 /// lower the noise of the verge estimate roughly as 1/√N.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GuidedConfig {
-    /// Matched neighbours whose median disparity predicts the position (the default's five:
-    /// with up to two of them false, their median stays within the true ones' disparities).
+    /// Matched neighbours whose median parallax (displacement beyond the rotation homography's)
+    /// predicts the position (the default's five: with up to two of them false, their median
+    /// stays within the true ones' parallaxes).
     pub neighbours: usize,
     /// Horizontal search range around the prediction (pixels). The default's 6: halving or
     /// doubling it moves the rendered road's raw median error by < 0.0002° and the KITTI
@@ -627,6 +628,12 @@ fn local_warp(h: &Matrix3<f64>, x: f32, y: f32) -> Warp {
     [j(0, 0, u), j(0, 1, u), j(1, 0, v), j(1, 1, v)]
 }
 
+/// Where `h` maps the pixel (`x`, `y`).
+fn map_point(h: &Matrix3<f64>, x: f32, y: f32) -> [f32; 2] {
+    let p = h * Vector3::new(f64::from(x), f64::from(y), 1.0);
+    [(p[0] / p[2]) as f32, (p[1] / p[2]) as f32]
+}
+
 /// A refined match as the estimator takes it: the pixel pair and its vertical 1-σ.
 fn refined(r: RefinedPair) -> (PixelPair, Option<f32>) {
     (
@@ -668,8 +675,9 @@ fn per_octave(octaves: impl Iterator<Item = u8>) -> Vec<usize> {
     counts
 }
 
-/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]),
-/// refined through `homography`'s local warp.
+/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]):
+/// each searched where `homography` maps it plus its neighbours' median parallax, and refined
+/// through `homography`'s local warp.
 #[allow(clippy::too_many_arguments)]
 fn guided_pairs(
     left: &FeatureFrame,
@@ -692,6 +700,18 @@ fn guided_pairs(
     let described: Vec<[f32; 2]> = pairs
         .iter()
         .map(|((l, _), _)| [l[0] as f32, l[1] as f32])
+        .collect();
+    // Each match's displacement beyond the rotation homography's: the parallax of its depth,
+    // which neighbours share. The homography's own part changes with the position, near a
+    // verged image's edge by up to a tenth of a pixel per pixel (the horizontal scale is 1/cos²
+    // of the angle off the axis), which a neighbour up to `max_neighbour_distance_px` away
+    // does not carry over.
+    let parallax: Vec<[f32; 2]> = pairs
+        .iter()
+        .map(|((l, r), _)| {
+            let at = map_point(homography, l[0] as f32, l[1] as f32);
+            [r[0] as f32 - at[0], r[1] as f32 - at[1]]
+        })
         .collect();
     // Several keypoints (octaves) can sit on the same pixel: each location is used once.
     let near_any = |taken: &[[f32; 2]], kp: &Keypoint| {
@@ -722,18 +742,16 @@ fn guided_pairs(
                     return None;
                 }
                 near.select_nth_unstable_by(g.neighbours - 1, |a, b| a.0.total_cmp(&b.0));
-                let median = |d: fn(&PixelPair) -> f64| {
+                let median = |axis: usize| {
                     let mut v: Vec<f32> = near[..g.neighbours]
                         .iter()
-                        .map(|&(_, i)| d(&pairs[i].0) as f32)
+                        .map(|&(_, i)| parallax[i][axis])
                         .collect();
                     v.sort_by(f32::total_cmp);
                     v[v.len() / 2]
                 };
-                let guess = [
-                    kp.x + median(|(l, r)| r[0] - l[0]),
-                    kp.y + median(|(l, r)| r[1] - l[1]),
-                ];
+                let at = map_point(homography, kp.x, kp.y);
+                let guess = [at[0] + median(0), at[1] + median(1)];
                 let warp = local_warp(homography, kp.x, kp.y);
                 guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, &warp, sub).map(|r| (kp, r))
             },
