@@ -105,12 +105,12 @@ pub struct GuidedConfig {
     /// stays within the true ones' parallaxes).
     pub neighbours: usize,
     /// Horizontal search range around the prediction (pixels). The default's 6: halving or
-    /// doubling it moves the rendered road's raw median error by < 0.0002° and the KITTI
-    /// drive's by < 0.005° (README, "Sensitivity of the constants").
+    /// doubling it moves the rendered road's raw median error by < 0.0003° and the KITTI
+    /// drive's by < 0.001° (README, "Sensitivity of the constants").
     pub search_px: i32,
     /// Only neighbours within this distance (pixels) are used. The default's 80: halving it
-    /// raises the rendered road's raw median error by 0.0008°, doubling it moves it by
-    /// < 0.0002°, and either moves the KITTI drive's by < 0.003°
+    /// raises the rendered road's raw median error by 0.0007° and the KITTI drive's by up to
+    /// 0.0015°; doubling it moves the road's by 0.0001° and the drive's by < 0.002°
     /// (README, "Sensitivity of the constants").
     pub max_neighbour_distance_px: f32,
 }
