@@ -26,6 +26,12 @@ use crate::essential::{Correspondence, EssentialError, RefineConfig};
 pub struct WindowConfig {
     /// Frames in the window.
     pub frames: usize,
+    /// Whether the right camera's pitch is estimated (else held at the calibration's). A
+    /// constant pitch moves every row alike, which on a forward-looking road view the yaws'
+    /// depth-dependent terms nearly reproduce, so a learned pitch and the verge trade for
+    /// each other as the view changes; a roll moves rows in proportion to the column, which
+    /// the verge (row times column) does not (README, "The head's fixed misalignments").
+    pub pitch: bool,
     /// Whether the baseline's tilt is estimated too (else held at the calibration's).
     pub tilt: bool,
     /// Joint Gauss-Newton steps per new frame.
@@ -47,6 +53,7 @@ impl Default for WindowConfig {
     fn default() -> Self {
         Self {
             frames: 30,
+            pitch: true,
             tilt: false,
             steps: 2,
             memory: 300,
@@ -223,7 +230,7 @@ impl MisalignmentWindow {
             }
         }
         // Held angles: their rows and columns leave the system.
-        let free = [true, true, self.config.tilt];
+        let free = [self.config.pitch, true, self.config.tilt];
         for (i, &f) in free.iter().enumerate() {
             if !f {
                 for j in 0..3 {
@@ -388,6 +395,33 @@ mod tests {
         assert!((est.pitch_deg + 0.1).abs() < 0.01, "{est:?}");
         assert!((est.roll_deg - 0.05).abs() < 0.01, "{est:?}");
         assert!((est.baseline_tilt_deg - 0.3).abs() < 0.05, "{est:?}");
+    }
+
+    /// With the pitch held, the window learns the roll alone and leaves the pitch at the
+    /// calibration's, with no uncertainty.
+    #[test]
+    fn the_window_learns_the_roll_alone_when_the_pitch_is_held() {
+        let truth = Misalignment {
+            pitch: 0.0,
+            roll: 0.08f64.to_radians(),
+            tilt: 0.0,
+        };
+        let refine = RefineConfig::default();
+        let config = WindowConfig {
+            pitch: false,
+            ..WindowConfig::default()
+        };
+        let mut window = MisalignmentWindow::new(&Extrinsics::default(), config, refine);
+        for k in 0..30u64 {
+            let a = VergeAngles::new((0.5 + 0.02 * k as f64).to_radians(), -0.3f64.to_radians());
+            let m = misaligned_synthetic(a, &truth, 600, 0.1, 700.0, 400 + k);
+            let plain = constrained::refine(&m, a, &refine).unwrap();
+            window.update(m, plain.angles).unwrap();
+        }
+        let est = window.estimate();
+        assert_eq!((est.pitch_deg, est.pitch_sigma_deg), (0.0, 0.0), "{est:?}");
+        assert!((est.roll_deg - 0.08).abs() < 0.01, "{est:?}");
+        assert!(est.roll_sigma_deg > 0.0, "{est:?}");
     }
 
     /// Frames that leave a short window keep informing the shared angles through the prior:

@@ -86,7 +86,7 @@ impl Effect {
 #[test]
 fn every_optional_mode_estimates_the_verge() {
     let default = eval(&[]);
-    let modes: [(&[&str], Effect, f64); 14] = [
+    let modes: [(&[&str], Effect, f64); 15] = [
         (&["--descriptor", "reduced16"], Effect::OtherMatches, 0.05),
         (&["--rotate"], Effect::OtherMatches, 0.05),
         (&["--no-cross-check"], Effect::OtherMatches, 0.05),
@@ -106,6 +106,11 @@ fn every_optional_mode_estimates_the_verge() {
         ),
         (
             &["--misalignment", "window-tilt"],
+            Effect::SameMatchesOtherEstimates,
+            0.05,
+        ),
+        (
+            &["--misalignment", "window-roll"],
             Effect::SameMatchesOtherEstimates,
             0.05,
         ),
@@ -137,6 +142,12 @@ fn every_optional_mode_estimates_the_verge() {
             assert_eq!(
                 tilt_sigma > 0.0,
                 extra[1] == "window-tilt",
+                "{extra:?}: {m}"
+            );
+            let pitch_sigma = number(m, "pitch_sigma_deg");
+            assert_eq!(
+                pitch_sigma > 0.0,
+                extra[1] != "window-roll",
                 "{extra:?}: {m}"
             );
         } else {
