@@ -371,6 +371,20 @@ mod tests {
         );
     }
 
+    /// The estimate of a window `config` after 30 frames of a head misaligned by `truth`, its
+    /// verge creeping, 600 matches a frame (0.1 px noise) drawn with seeds from `seed`.
+    fn learned(truth: &Misalignment, config: WindowConfig, seed: u64) -> MisalignmentEstimate {
+        let refine = RefineConfig::default();
+        let mut window = MisalignmentWindow::new(&Extrinsics::default(), config, refine);
+        for k in 0..30u64 {
+            let a = VergeAngles::new((0.5 + 0.02 * k as f64).to_radians(), -0.3f64.to_radians());
+            let m = misaligned_synthetic(a, truth, 600, 0.1, 700.0, seed + k);
+            let plain = constrained::refine(&m, a, &refine).unwrap();
+            window.update(m, plain.angles).unwrap();
+        }
+        window.estimate()
+    }
+
     /// With the baseline's tilt free too, a tilted baseline is recovered as well.
     #[test]
     fn the_window_learns_a_baseline_tilt_when_asked() {
@@ -379,19 +393,11 @@ mod tests {
             roll: 0.05f64.to_radians(),
             tilt: 0.3f64.to_radians(),
         };
-        let refine = RefineConfig::default();
         let config = WindowConfig {
             tilt: true,
             ..WindowConfig::default()
         };
-        let mut window = MisalignmentWindow::new(&Extrinsics::default(), config, refine);
-        for k in 0..30u64 {
-            let a = VergeAngles::new((0.5 + 0.02 * k as f64).to_radians(), -0.3f64.to_radians());
-            let m = misaligned_synthetic(a, &truth, 600, 0.1, 700.0, 200 + k);
-            let plain = constrained::refine(&m, a, &refine).unwrap();
-            window.update(m, plain.angles).unwrap();
-        }
-        let est = window.estimate();
+        let est = learned(&truth, config, 200);
         assert!((est.pitch_deg + 0.1).abs() < 0.01, "{est:?}");
         assert!((est.roll_deg - 0.05).abs() < 0.01, "{est:?}");
         assert!((est.baseline_tilt_deg - 0.3).abs() < 0.05, "{est:?}");
@@ -406,19 +412,11 @@ mod tests {
             roll: 0.08f64.to_radians(),
             tilt: 0.0,
         };
-        let refine = RefineConfig::default();
         let config = WindowConfig {
             pitch: false,
             ..WindowConfig::default()
         };
-        let mut window = MisalignmentWindow::new(&Extrinsics::default(), config, refine);
-        for k in 0..30u64 {
-            let a = VergeAngles::new((0.5 + 0.02 * k as f64).to_radians(), -0.3f64.to_radians());
-            let m = misaligned_synthetic(a, &truth, 600, 0.1, 700.0, 400 + k);
-            let plain = constrained::refine(&m, a, &refine).unwrap();
-            window.update(m, plain.angles).unwrap();
-        }
-        let est = window.estimate();
+        let est = learned(&truth, config, 400);
         assert_eq!((est.pitch_deg, est.pitch_sigma_deg), (0.0, 0.0), "{est:?}");
         assert!((est.roll_deg - 0.08).abs() < 0.01, "{est:?}");
         assert!(est.roll_sigma_deg > 0.0, "{est:?}");
