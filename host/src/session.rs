@@ -31,8 +31,10 @@ pub struct SessionConfig {
     pub kalman: KalmanConfig,
     /// Which Sobel output the fabric streams (full rows, as the thesis, or 16x16 patches).
     pub sobel_output: SobelOutput,
-    /// Learn the head's fixed pitch and roll over a sliding window of frames and refit each
-    /// frame's verge with them held (constrained model only); `None`: each frame alone.
+    /// Learn the head's fixed misalignments over a sliding window of frames and refit each
+    /// frame's verge with them held (constrained model only; the general model frees them in
+    /// every frame); `None`: each frame alone. The default learns the roll
+    /// ([`WindowConfig::roll`]).
     pub misalignment: Option<WindowConfig>,
     /// How the link is guarded against damage (packing, error correction, loss limit).
     pub link: LinkProtection,
@@ -44,7 +46,7 @@ impl Default for SessionConfig {
             estimator: EstimatorConfig::default(),
             kalman: KalmanConfig::default(),
             sobel_output: SobelOutput::Rows,
-            misalignment: None,
+            misalignment: Some(WindowConfig::roll()),
             link: LinkProtection::clean(),
         }
     }
@@ -453,9 +455,12 @@ impl<L: Link> Session<L> {
         Ok(record)
     }
 
-    /// With a misalignment window: hands the frame's consistent matches to it and takes its
-    /// refit verge, recording the window's misalignment estimate. A frame the window cannot
-    /// refit keeps its own estimate.
+    /// With a misalignment window: hands the frame's consistent matches to it and moves the
+    /// frame's yaws by what the learned misalignments move them
+    /// ([`crate::misalignment::WindowFit::shift`]),
+    /// recording the window's misalignment estimate. The frame's σ stays its own: the learned
+    /// angles' uncertainty, which falls with every frame the window sees, adds little to it. A
+    /// frame the window cannot refit keeps its own estimate.
     fn refit_misaligned(
         &mut self,
         mut est: FrameEstimate,
@@ -465,9 +470,9 @@ impl<L: Link> Session<L> {
             return est;
         };
         if let Ok(fit) = window.update(std::mem::take(&mut est.consistent), angles) {
-            est.verge_deg = fit.angles.verge_deg();
-            est.sigma_deg = fit.verge_sigma.to_degrees();
-            est.angles = Some(fit.angles);
+            let shifted = fit.corrected(angles);
+            est.verge_deg = shifted.verge_deg();
+            est.angles = Some(shifted);
         }
         record.misalignment = Some(window.estimate());
         est

@@ -32,7 +32,7 @@ pub enum MisalignmentArg {
     Window,
     /// As `window`, and the baseline's tilt too.
     WindowTilt,
-    /// As `window`, the roll alone: the pitch held at the calibration's.
+    /// As `window`, the roll alone: the pitch held at the calibration's (the default).
     WindowRoll,
 }
 
@@ -91,11 +91,10 @@ pub struct EstimateArgs {
     #[arg(long, value_enum, default_value_t = ModelArg::Constrained)]
     model: ModelArg,
     /// The head's fixed misalignments: each frame alone, or learned over a window
-    /// (constrained model only; the general model frees them in every frame). Off by default:
-    /// on the one real drive there is, `window` lowers every trajectory's maximum error but
-    /// raises the moving and swing medians, and `window-roll` lowers all but the swing's
-    /// maximum; one drive does not make a default (README, "The head's fixed misalignments").
-    #[arg(long, value_enum, default_value_t = MisalignmentArg::Off)]
+    /// (constrained model only; the general model frees them in every frame). The default
+    /// learns the roll alone, which no view trades for the verge; `window` adds the pitch,
+    /// which a road view does trade for it (README, "The head's fixed misalignments").
+    #[arg(long, value_enum, default_value_t = MisalignmentArg::WindowRoll)]
     misalignment: MisalignmentArg,
     /// Sobel output mode of the fabric.
     #[arg(long, value_enum, default_value_t = SobelArg::Rows)]
@@ -141,10 +140,7 @@ impl EstimateArgs {
                 tilt: true,
                 ..WindowConfig::default()
             }),
-            MisalignmentArg::WindowRoll => Some(WindowConfig {
-                pitch: false,
-                ..WindowConfig::default()
-            }),
+            MisalignmentArg::WindowRoll => Some(WindowConfig::roll()),
         };
         config.sobel_output = match self.sobel {
             SobelArg::Rows => SobelOutput::Rows,

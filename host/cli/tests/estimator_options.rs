@@ -1,8 +1,9 @@
 //! The estimator's optional modes reach it from the command line and each still measures the
 //! verge: the reduced 16-element descriptor and dominant-orientation rotation (thesis 6.3),
 //! matching without the left-right check or the vertical-disparity gate or with another ratio
-//! or a best-N cut, the solve without RANSAC, with the general five-degree-of-freedom model or
-//! with the head's fixed misalignments learned over a window (which reports them), and Sobel
+//! or a best-N cut, the solve without RANSAC, with the general five-degree-of-freedom model,
+//! with each frame alone or with more of the head's fixed misalignments learned over the
+//! window (which reports them) than the default's roll, and Sobel
 //! patches on the wire. Each must show its effect (so the flag took effect): a mode of the
 //! matcher changes the matches, `--best N` keeps N of them, the solver's modes keep the
 //! matches and change the estimates, and patches cut the wire bytes. None loses a frame, and
@@ -109,8 +110,9 @@ fn every_optional_mode_estimates_the_verge() {
             Effect::SameMatchesOtherEstimates,
             0.05,
         ),
+        // The default learns the roll over a window; `off` takes each frame alone.
         (
-            &["--misalignment", "window-roll"],
+            &["--misalignment", "off"],
             Effect::SameMatchesOtherEstimates,
             0.05,
         ),
@@ -131,27 +133,27 @@ fn every_optional_mode_estimates_the_verge() {
             effect.holds(&j, &default),
             "{extra:?}: no {effect:?} in {j} against the default {default}"
         );
-        // The window reports its estimate; the rendered head has no misalignment, and the
-        // baseline's tilt is estimated only when asked.
+        // The window reports its estimate; the rendered head has no misalignment, the
+        // pitch is estimated unless only the roll is (the default), and the baseline's tilt
+        // only when asked. Each frame alone, and the general model, which frees the
+        // misalignments in every frame, report none.
         let m = &j["misalignment"];
-        if extra[0] == "--misalignment" {
-            assert_eq!(m["frames"], 8, "{extra:?}: {j}");
-            assert!(number(m, "pitch_deg").abs() < 0.05, "{extra:?}: {m}");
-            assert!(number(m, "roll_deg").abs() < 0.05, "{extra:?}: {m}");
-            let tilt_sigma = number(m, "baseline_tilt_sigma_deg");
-            assert_eq!(
-                tilt_sigma > 0.0,
-                extra[1] == "window-tilt",
-                "{extra:?}: {m}"
-            );
-            let pitch_sigma = number(m, "pitch_sigma_deg");
-            assert_eq!(
-                pitch_sigma > 0.0,
-                extra[1] != "window-roll",
-                "{extra:?}: {m}"
-            );
-        } else {
-            assert!(m.is_null(), "{extra:?}: {j}");
+        let window = match extra {
+            ["--misalignment", "off"] | ["--model", "general"] => None,
+            ["--misalignment", mode] => Some(*mode),
+            _ => Some("window-roll"),
+        };
+        match window {
+            Some(mode) => {
+                assert_eq!(m["frames"], 8, "{extra:?}: {j}");
+                assert!(number(m, "pitch_deg").abs() < 0.05, "{extra:?}: {m}");
+                assert!(number(m, "roll_deg").abs() < 0.05, "{extra:?}: {m}");
+                let tilt_sigma = number(m, "baseline_tilt_sigma_deg");
+                assert_eq!(tilt_sigma > 0.0, mode == "window-tilt", "{extra:?}: {m}");
+                let pitch_sigma = number(m, "pitch_sigma_deg");
+                assert_eq!(pitch_sigma > 0.0, mode != "window-roll", "{extra:?}: {m}");
+            }
+            None => assert!(m.is_null(), "{extra:?}: {j}"),
         }
     }
 }
