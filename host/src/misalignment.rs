@@ -212,11 +212,12 @@ impl MisalignmentWindow {
         matches: Vec<Correspondence>,
         start: VergeAngles,
     ) -> Result<WindowFit, EssentialError> {
+        // The refit with the calibration's angles is the shift's reference and, the learned
+        // angles being small corrections to them, the frame's start in the joint steps.
         let calibrated = misaligned::refine_yaws(&matches, start, &self.calibration, &self.refine)?;
-        let first = misaligned::refine_yaws(&matches, start, &self.shared, &self.refine)?;
         self.frames.push_back(WindowFrame {
             matches,
-            angles: first.angles,
+            angles: calibrated.angles,
         });
         while self.frames.len() > self.config.frames {
             if let Some(old) = self.frames.pop_front() {
