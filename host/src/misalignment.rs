@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use crate::calib::Extrinsics;
 use crate::essential::constrained::VergeAngles;
-use crate::essential::misaligned::{self, Misalignment, YawFit};
+use crate::essential::misaligned::{self, Misalignment};
 use crate::essential::{Correspondence, EssentialError, RefineConfig};
 
 /// Which misalignments the window estimates (`--misalignment`).
@@ -105,10 +105,8 @@ pub struct MisalignmentEstimate {
 }
 
 /// What the window makes of a new frame.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WindowFit {
-    /// The frame's yaws refitted with the learned misalignments held.
-    pub learned: YawFit,
     /// What the learned misalignments, against the calibration's, move the frame's yaws by
     /// (radians, left and right): the refit with the learned angles less the refit with the
     /// calibration's, on the same matches from the same start.
@@ -206,7 +204,7 @@ impl MisalignmentWindow {
 
     /// Takes a new frame's consistent matches (calibrated, with the estimator's weights) and
     /// its yaws from the per-frame fit; moves the window on, refines the shared angles, and
-    /// returns the frame's yaws refitted with them held and what they move the yaws by.
+    /// returns what they move the frame's yaws by.
     pub fn update(
         &mut self,
         matches: Vec<Correspondence>,
@@ -235,7 +233,7 @@ impl MisalignmentWindow {
             learned.angles.alpha_l - calibrated.angles.alpha_l,
             learned.angles.alpha_r - calibrated.angles.alpha_r,
         );
-        Ok(WindowFit { learned, shift })
+        Ok(WindowFit { shift })
     }
 
     /// Folds what `frame` says about the shared angles, its yaws eliminated, into the prior,

@@ -31,9 +31,9 @@ pub struct SessionConfig {
     pub kalman: KalmanConfig,
     /// Which Sobel output the fabric streams (full rows, as the thesis, or 16x16 patches).
     pub sobel_output: SobelOutput,
-    /// Learn the head's fixed misalignments over a sliding window of frames and refit each
-    /// frame's verge with them held (constrained model only; the general model frees them in
-    /// every frame); `None`: each frame alone. The default learns the roll
+    /// Learn the head's fixed misalignments over a sliding window of frames and correct each
+    /// frame's verge by what holding them moves its refit (constrained model only; the general
+    /// model frees them in every frame); `None`: each frame alone. The default learns the roll
     /// ([`WindowConfig::roll`]).
     pub misalignment: Option<WindowConfig>,
     /// How the link is guarded against damage (packing, error correction, loss limit).
