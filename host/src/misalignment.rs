@@ -8,7 +8,8 @@
 //! jointly, and the current frame's yaws are then refitted twice on its matches
 //! ([`misaligned::refine_yaws`]): with the learned angles held and with the calibration's.
 //! The difference of the two is what the learned misalignments move the frame's yaws by,
-//! and it corrects the per-frame estimate ([`WindowFit`]): the refit alone would also carry
+//! and it corrects the per-frame estimate ([`MisalignmentWindow::update`]): the refit alone
+//! would also carry
 //! the difference between its robust fit of the consistent matches and the estimator's of
 //! all of them (a few thousandths of a degree on rendered truth, where nothing is
 //! misaligned), and with the calibration's angles learned the correction is exactly zero.
@@ -104,25 +105,6 @@ pub struct MisalignmentEstimate {
     pub frames: usize,
 }
 
-/// What the window makes of a new frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WindowFit {
-    /// What the learned misalignments, against the calibration's, move the frame's yaws by
-    /// (radians, left and right): the refit with the learned angles less the refit with the
-    /// calibration's, on the same matches from the same start.
-    pub shift: VergeAngles,
-}
-
-impl WindowFit {
-    /// The frame's own yaws `own` (the per-frame estimate's) moved by [`WindowFit::shift`].
-    pub fn corrected(&self, own: VergeAngles) -> VergeAngles {
-        VergeAngles::new(
-            own.alpha_l + self.shift.alpha_l,
-            own.alpha_r + self.shift.alpha_r,
-        )
-    }
-}
-
 /// One frame in the window: its consistent matches and its current yaws.
 #[derive(Debug, Clone)]
 struct WindowFrame {
@@ -176,11 +158,12 @@ pub struct MisalignmentWindow {
 impl MisalignmentWindow {
     /// Starts from the calibration's misalignments (zero for a rectified pair).
     pub fn new(extrinsics: &Extrinsics, config: WindowConfig, refine: RefineConfig) -> Self {
+        let calibration = Misalignment::from_extrinsics(extrinsics);
         Self {
             config,
             refine,
-            calibration: Misalignment::from_extrinsics(extrinsics),
-            shared: Misalignment::from_extrinsics(extrinsics),
+            calibration,
+            shared: calibration,
             covariance: Matrix3::zeros(),
             frames: VecDeque::with_capacity(config.frames + 1),
             prior_information: Matrix3::zeros(),
@@ -204,12 +187,14 @@ impl MisalignmentWindow {
 
     /// Takes a new frame's consistent matches (calibrated, with the estimator's weights) and
     /// its yaws from the per-frame fit; moves the window on, refines the shared angles, and
-    /// returns what they move the frame's yaws by.
+    /// returns the frame's yaws moved by what the learned angles, against the calibration's,
+    /// move its refit (the refit with them held less the refit with the calibration's, on the
+    /// same matches from the same start).
     pub fn update(
         &mut self,
         matches: Vec<Correspondence>,
         start: VergeAngles,
-    ) -> Result<WindowFit, EssentialError> {
+    ) -> Result<VergeAngles, EssentialError> {
         // The refit with the calibration's angles is the shift's reference and, the learned
         // angles being small corrections to them, the frame's start in the joint steps.
         let calibrated = misaligned::refine_yaws(&matches, start, &self.calibration, &self.refine)?;
@@ -229,11 +214,10 @@ impl MisalignmentWindow {
         let learned =
             misaligned::refine_yaws(&newest.matches, newest.angles, &self.shared, &self.refine)?;
         newest.angles = learned.angles;
-        let shift = VergeAngles::new(
-            learned.angles.alpha_l - calibrated.angles.alpha_l,
-            learned.angles.alpha_r - calibrated.angles.alpha_r,
-        );
-        Ok(WindowFit { shift })
+        Ok(VergeAngles::new(
+            start.alpha_l + (learned.angles.alpha_l - calibrated.angles.alpha_l),
+            start.alpha_r + (learned.angles.alpha_r - calibrated.angles.alpha_r),
+        ))
     }
 
     /// Folds what `frame` says about the shared angles, its yaws eliminated, into the prior,
@@ -395,10 +379,9 @@ mod tests {
                     .filter(|c| c.left[(k as usize / 2) % 2] * side > 0.0)
                     .collect();
             let plain = constrained::refine(&m, a, &refine).unwrap();
-            let fit = window.update(m, plain.angles).unwrap();
+            let corrected = window.update(m, plain.angles).unwrap();
             if k >= 10 {
                 plain_err.push((plain.angles.verge() - a.verge()).to_degrees().abs());
-                let corrected = fit.corrected(plain.angles);
                 window_err.push((corrected.verge() - a.verge()).to_degrees().abs());
             }
         }

@@ -455,12 +455,11 @@ impl<L: Link> Session<L> {
         Ok(record)
     }
 
-    /// With a misalignment window: hands the frame's consistent matches to it and moves the
-    /// frame's yaws by what the learned misalignments move them
-    /// ([`crate::misalignment::WindowFit::shift`]),
+    /// With a misalignment window: hands the frame's consistent matches to it and takes the
+    /// frame's yaws corrected for the learned misalignments ([`MisalignmentWindow::update`]),
     /// recording the window's misalignment estimate. The frame's σ stays its own: the learned
-    /// angles' uncertainty, which falls with every frame the window sees, adds little to it. A
-    /// frame the window cannot refit keeps its own estimate.
+    /// angles' uncertainty, which falls with every frame the window sees, adds little to it.
+    /// A frame the window cannot refit keeps its own estimate.
     fn refit_misaligned(
         &mut self,
         mut est: FrameEstimate,
@@ -469,10 +468,9 @@ impl<L: Link> Session<L> {
         let (Some(window), Some(angles)) = (&mut self.misalignment, est.angles) else {
             return est;
         };
-        if let Ok(fit) = window.update(std::mem::take(&mut est.consistent), angles) {
-            let shifted = fit.corrected(angles);
-            est.verge_deg = shifted.verge_deg();
-            est.angles = Some(shifted);
+        if let Ok(corrected) = window.update(std::mem::take(&mut est.consistent), angles) {
+            est.verge_deg = corrected.verge_deg();
+            est.angles = Some(corrected);
         }
         record.misalignment = Some(window.estimate());
         est
