@@ -7,6 +7,7 @@
 //! starting point and a Cauchy-weighted Gauss-Newton refinement over all matches gives the
 //! answer and its uncertainty.
 
+use std::num::NonZeroU16;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use nalgebra::{Matrix3, Vector3};
@@ -113,6 +114,12 @@ pub struct GuidedConfig {
     /// 0.0015°; doubling it moves the road's by 0.0001° and the drive's by < 0.002°
     /// (README, "Sensitivity of the constants").
     pub max_neighbour_distance_px: f32,
+    /// Also searches, in every `grid_px` x `grid_px` cell of the left magnitude plane, its
+    /// strongest pixel that no match lies within half a cell of. Where the matches' sub-pixel
+    /// noise limits the verge (a noisy sensor, an exact rendering) the extra points lower it;
+    /// where errors shared by neighbouring points do (the real drive), they do not, and they
+    /// cost a refinement each. `None` (the default): keypoints only (README, "Grid points").
+    pub grid_px: Option<NonZeroU16>,
 }
 
 impl Default for GuidedConfig {
@@ -121,6 +128,7 @@ impl Default for GuidedConfig {
             neighbours: 5,
             search_px: 6,
             max_neighbour_distance_px: 80.0,
+            grid_px: None,
         }
     }
 }
@@ -675,9 +683,9 @@ fn per_octave(octaves: impl Iterator<Item = u8>) -> Vec<usize> {
     counts
 }
 
-/// Guided matches for the left keypoints that have no descriptor match (see [`GuidedConfig`]):
-/// each searched where `homography` maps it plus its neighbours' median parallax, and refined
-/// through `homography`'s local warp.
+/// Guided matches for the left keypoints that have no descriptor match, and for the grid
+/// points when configured (see [`GuidedConfig`]): each searched where `homography` maps it
+/// plus its neighbours' median parallax, and refined through `homography`'s local warp.
 #[allow(clippy::too_many_arguments)]
 fn guided_pairs(
     left: &FeatureFrame,
@@ -713,61 +721,113 @@ fn guided_pairs(
             [r[0] as f32 - at[0], r[1] as f32 - at[1]]
         })
         .collect();
-    // Several keypoints (octaves) can sit on the same pixel: each location is used once.
-    let near_any = |taken: &[[f32; 2]], kp: &Keypoint| {
-        taken
-            .iter()
-            // Within a pixel in each direction (the snapped points' 3x3 neighbourhood), with
-            // half a pixel to spare for a keypoint off the octave-0 grid: such points share
-            // nearly all of their 15x15 windows, so they are one location.
-            .any(|t| (t[0] - kp.x).abs() < 1.5 && (t[1] - kp.y).abs() < 1.5)
+    // The search for the left point `p`; `near` is room for its neighbours.
+    let search = |near: &mut Vec<(f32, usize)>, p: [f32; 2]| {
+        near.clear();
+        near.extend(pairs.iter().enumerate().filter_map(|(i, ((l, _), _))| {
+            let d2 = (l[0] as f32 - p[0]).powi(2) + (l[1] as f32 - p[1]).powi(2);
+            (d2 <= max_d2).then_some((d2, i))
+        }));
+        if near.len() < g.neighbours {
+            return None;
+        }
+        near.select_nth_unstable_by(g.neighbours - 1, |a, b| a.0.total_cmp(&b.0));
+        let median = |axis: usize| {
+            let mut v: Vec<f32> = near[..g.neighbours]
+                .iter()
+                .map(|&(_, i)| parallax[i][axis])
+                .collect();
+            v.sort_by(f32::total_cmp);
+            v[v.len() / 2]
+        };
+        let at = map_point(homography, p[0], p[1]);
+        let guess = [at[0] + median(0), at[1] + median(1)];
+        let warp = local_warp(homography, p[0], p[1]);
+        guided_pair(pl, pr, p, guess, g.search_px, &warp, sub)
     };
+    // Several keypoints (octaves) can sit on the same pixel: each location is used once.
+    // Within a pixel in each direction (the snapped points' 3x3 neighbourhood), with half a
+    // pixel to spare for a keypoint off the octave-0 grid: such points share nearly all of
+    // their 15x15 windows, so they are one location.
+    let one_location = |taken: &[[f32; 2]], p: [f32; 2]| near_any(taken, p, 1.5);
     // The searches are independent: both cores run them. Which of them a location already
     // taken by an earlier guided match rules out is settled afterwards, in keypoint order,
     // which gives the matches a one-by-one loop would.
-    let found: Vec<(&Keypoint, RefinedPair)> = left
+    let found: Vec<([f32; 2], RefinedPair)> = left
         .keypoints()
         .par_iter()
         .enumerate()
-        .filter(|&(k, kp)| !matched[k] && !near_any(&described, kp))
+        .filter(|&(k, kp)| !matched[k] && !one_location(&described, [kp.x, kp.y]))
         .map_init(
             || Vec::with_capacity(pairs.len()),
-            |near: &mut Vec<(f32, usize)>, (_, kp)| {
-                near.clear();
-                near.extend(pairs.iter().enumerate().filter_map(|(i, ((l, _), _))| {
-                    let d2 = (l[0] as f32 - kp.x).powi(2) + (l[1] as f32 - kp.y).powi(2);
-                    (d2 <= max_d2).then_some((d2, i))
-                }));
-                if near.len() < g.neighbours {
-                    return None;
-                }
-                near.select_nth_unstable_by(g.neighbours - 1, |a, b| a.0.total_cmp(&b.0));
-                let median = |axis: usize| {
-                    let mut v: Vec<f32> = near[..g.neighbours]
-                        .iter()
-                        .map(|&(_, i)| parallax[i][axis])
-                        .collect();
-                    v.sort_by(f32::total_cmp);
-                    v[v.len() / 2]
-                };
-                let at = map_point(homography, kp.x, kp.y);
-                let guess = [at[0] + median(0), at[1] + median(1)];
-                let warp = local_warp(homography, kp.x, kp.y);
-                guided_pair(pl, pr, [kp.x, kp.y], guess, g.search_px, &warp, sub).map(|r| (kp, r))
-            },
+            |near, (_, kp)| search(near, [kp.x, kp.y]).map(|r| ([kp.x, kp.y], r)),
         )
         .flatten()
         .collect();
     let mut taken = Vec::new();
     let mut out = Vec::new();
-    for (kp, r) in found {
-        if near_any(&taken, kp) {
+    for (p, r) in found {
+        if one_location(&taken, p) {
             continue;
         }
         taken.push(r.left);
         out.push(refined(r));
     }
+    if let Some(cell) = g.grid_px.map(NonZeroU16::get) {
+        // A point closer than half a cell to another has a window that overlaps the other's:
+        // the grid's points keep to the spacing of its cells.
+        let half_cell = f32::from(cell) / 2.0;
+        let mut all = described;
+        all.extend_from_slice(&taken);
+        let found: Vec<RefinedPair> = grid_points(pl, usize::from(cell))
+            .par_iter()
+            .filter(|&&p| !near_any(&all, p, half_cell))
+            .map_init(
+                || Vec::with_capacity(pairs.len()),
+                |near, &p| search(near, p),
+            )
+            .flatten()
+            .collect();
+        for r in found {
+            if near_any(&all, r.left, half_cell) {
+                continue;
+            }
+            all.push(r.left);
+            out.push(refined(r));
+        }
+    }
     out
+}
+
+/// Whether a point of `taken` lies within `reach` of `p` in both directions.
+fn near_any(taken: &[[f32; 2]], p: [f32; 2], reach: f32) -> bool {
+    taken
+        .iter()
+        .any(|t| (t[0] - p[0]).abs() < reach && (t[1] - p[1]).abs() < reach)
+}
+
+/// The strongest pixel of every whole `cell` x `cell` cell of `plane` (the first in row order
+/// among equals), in full-resolution pixels; cells with no gradient at all give none.
+fn grid_points(plane: &SobelPlane, cell: usize) -> Vec<[f32; 2]> {
+    let (w, h) = (plane.width() as usize, plane.height() as usize);
+    let m = plane.magnitude();
+    let mut points = Vec::new();
+    for y0 in (0..h / cell).map(|i| i * cell) {
+        for x0 in (0..w / cell).map(|i| i * cell) {
+            let mut best = (0u8, 0, 0);
+            for y in y0..y0 + cell {
+                for (dx, &v) in m[y * w + x0..][..cell].iter().enumerate() {
+                    if v > best.0 {
+                        best = (v, x0 + dx, y);
+                    }
+                }
+            }
+            if best.0 > 0 {
+                points.push([best.1 as f32, best.2 as f32]);
+            }
+        }
+    }
+    points
 }
 
 #[cfg(test)]
@@ -881,5 +941,21 @@ mod tests {
         )
         .unwrap();
         assert!((from_parallel.angles.verge_deg() - 15.0).abs() > 1e-3);
+    }
+
+    #[test]
+    fn grid_points_are_each_whole_cells_strongest_pixel() {
+        // A 10x7 plane in 4x4 cells: two whole cells across, one down (the last columns and
+        // rows make no whole cell).
+        let mut mag = vec![0u8; 70];
+        mag[10 + 2] = 9; // cell (0, 0): (2, 1)
+        mag[30 + 1] = 9; // the same cell, as strong but later in row order
+        mag[20 + 5] = 3; // cell (1, 0): (5, 2)
+        mag[60 + 9] = 200; // outside every whole cell
+        let plane = SobelPlane::new(0, 10, 7, mag, vec![0; 70]).unwrap();
+        assert_eq!(grid_points(&plane, 4), vec![[2.0, 1.0], [5.0, 2.0]]);
+        // A cell without gradient gives no point.
+        let flat = SobelPlane::new(0, 8, 4, vec![0; 32], vec![0; 32]).unwrap();
+        assert!(grid_points(&flat, 4).is_empty());
     }
 }

@@ -1,7 +1,9 @@
 //! Flags shared by every command that estimates: the estimator's knobs and the output mode.
 //!
-//! The defaults are the estimator's defaults, the most accurate settings for a verge head;
-//! each flag only moves away from them.
+//! The defaults are the estimator's defaults, the most accurate settings for a verge head on
+//! the real drive at full speed; each flag only moves away from them.
+
+use std::num::NonZeroU16;
 
 use clap::{Args, ValueEnum};
 use stereocal::descriptor::DescriptorMode;
@@ -96,6 +98,11 @@ pub struct EstimateArgs {
     /// which a road view does trade for it (README, "The head's fixed misalignments").
     #[arg(long, value_enum, default_value_t = MisalignmentArg::WindowRoll)]
     misalignment: MisalignmentArg,
+    /// Also match the strongest Sobel pixel of every PX x PX cell of the left image, beside
+    /// the keypoints: lowers the verge's noise where the matches' sub-pixel noise limits it,
+    /// at a refinement per point (README, "Grid points"). Default: keypoints only.
+    #[arg(long, value_name = "PX")]
+    grid: Option<NonZeroU16>,
     /// Sobel output mode of the fabric.
     #[arg(long, value_enum, default_value_t = SobelArg::Rows)]
     sobel: SobelArg,
@@ -126,6 +133,9 @@ impl EstimateArgs {
             DescriptorArg::Reduced16 => DescriptorMode::Reduced16,
         };
         e.descriptor.rotate = self.rotate;
+        if let Some(guided) = &mut e.guided {
+            guided.grid_px = self.grid;
+        }
         e.model = match self.model {
             ModelArg::Constrained => Model::Constrained,
             ModelArg::General => Model::General,

@@ -87,7 +87,7 @@ impl Effect {
 #[test]
 fn every_optional_mode_estimates_the_verge() {
     let default = eval(&[]);
-    let modes: [(&[&str], Effect, f64); 15] = [
+    let modes: [(&[&str], Effect, f64); 16] = [
         (&["--descriptor", "reduced16"], Effect::OtherMatches, 0.05),
         (&["--rotate"], Effect::OtherMatches, 0.05),
         (&["--no-cross-check"], Effect::OtherMatches, 0.05),
@@ -116,6 +116,8 @@ fn every_optional_mode_estimates_the_verge() {
             Effect::SameMatchesOtherEstimates,
             0.05,
         ),
+        // Grid points add guided matches, not descriptor matches.
+        (&["--grid", "12"], Effect::SameMatchesOtherEstimates, 0.05),
         (&["--sobel", "patches"], Effect::WireBytesAtMost(0.6), 0.1),
         // Parity and smaller packets change the bytes on the link, not what arrives.
         (
