@@ -777,22 +777,25 @@ fn guided_pairs(
         // A point closer than half a cell to another has a window that overlaps the other's:
         // the grid's points keep to the spacing of its cells.
         let half_cell = f32::from(cell) / 2.0;
-        let mut all = described;
-        all.extend_from_slice(&taken);
+        let mut occupied = described;
+        occupied.extend_from_slice(&taken);
         let found: Vec<RefinedPair> = grid_points(pl, usize::from(cell))
             .par_iter()
-            .filter(|&&p| !near_any(&all, p, half_cell))
+            .filter(|&&p| !near_any(&occupied, p, half_cell))
             .map_init(
                 || Vec::with_capacity(pairs.len()),
                 |near, &p| search(near, p),
             )
             .flatten()
             .collect();
+        // A grid point's refined left point is the grid point itself (a whole pixel), which
+        // the filter above kept clear of the matches: only the grid's own points can be near.
+        let mut added = Vec::new();
         for r in found {
-            if near_any(&all, r.left, half_cell) {
+            if near_any(&added, r.left, half_cell) {
                 continue;
             }
-            all.push(r.left);
+            added.push(r.left);
             out.push(refined(r));
         }
     }

@@ -9,12 +9,11 @@
 //! ([`misaligned::refine_yaws`]): with the learned angles held and with the calibration's.
 //! The difference of the two is what the learned misalignments move the frame's yaws by,
 //! and it corrects the per-frame estimate ([`MisalignmentWindow::update`]): the refit alone
-//! would also carry
-//! the difference between its robust fit of the consistent matches and the estimator's of
-//! all of them (a few thousandths of a degree on rendered truth, where nothing is
-//! misaligned), and with the calibration's angles learned the correction is exactly zero.
-//! Each Gauss-Newton step eliminates the per-frame yaws by the
-//! Schur complement, so a step costs one pass over the window's matches and a 3x3 solve. A
+//! would also carry the difference between its robust fit of the consistent matches and the
+//! estimator's of all of them (a few thousandths of a degree on rendered truth, where nothing
+//! is misaligned), and with the calibration's angles learned the correction is exactly zero.
+//! Each Gauss-Newton step eliminates the per-frame yaws by the Schur complement, so a step
+//! costs one pass over the window's matches and a 3x3 solve. A
 //! frame that leaves the window leaves its information about the shared angles behind, as a
 //! Gaussian prior (marginalisation), so the window bounds the cost, not the memory.
 
