@@ -46,7 +46,8 @@ use stereocal::session::{Session, SessionConfig, SessionError};
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
 use stereocal_tools::eval::{fabric_size, sequence_calibration};
 use stereocal_tools::hil::{
-    compare_streams, run_on_qemu, HilError, QemuConfig, QemuRun, QemuTimeouts, DEFAULT_QEMU,
+    compare_streams, run_on_machine, HilError, MachineConfig, MachineRun, MachineTimeouts,
+    DEFAULT_QEMU,
 };
 
 /// One stereo pair.
@@ -173,10 +174,10 @@ pub fn run_in_process(scenario: &Scenario) -> Outcome {
 /// The scenario on the firmware under QEMU.
 pub fn run_qemu(
     scenario: &Scenario,
-    qemu: &QemuConfig,
-) -> Result<(Outcome, QemuRun<Vec<FrameRecord>>), HilError> {
+    qemu: &MachineConfig,
+) -> Result<(Outcome, MachineRun<Vec<FrameRecord>>), HilError> {
     let start = Instant::now();
-    let run = run_on_qemu(qemu, &scenario.grabber_input(), |device| {
+    let run = run_on_machine(qemu, &scenario.grabber_input(), |device| {
         Ok(scenario.run_session(device)?)
     })?;
     let outcome = Outcome {
@@ -205,7 +206,7 @@ pub fn assert_same_records(name: &str, qemu: &[FrameRecord], in_process: &[Frame
 
 /// The QEMU configuration for the tests, or `None` (after a loud `SKIPPED` line) when the
 /// emulator is not installed. Under `CI=true` a missing emulator is a failure.
-pub fn qemu_or_skip(test: &str) -> Option<QemuConfig> {
+pub fn qemu_or_skip(test: &str) -> Option<MachineConfig> {
     let found = Command::new(DEFAULT_QEMU)
         .arg("--version")
         .output()
@@ -219,25 +220,25 @@ pub fn qemu_or_skip(test: &str) -> Option<QemuConfig> {
         );
         return None;
     }
-    firmware_elf_or_skip(test).map(QemuConfig::new)
+    firmware_elf_or_skip(test).map(MachineConfig::new)
 }
 
 /// Why `build.rs` left the SoC model out of the binary `sc-soc-sim` (`None` when it is in).
 pub const SOC_SKIP: Option<&str> = option_env!("STEREOCAL_SOC_SKIP");
 
-/// The firmware ELF on the SoC in the loop ([`QemuConfig::soc`]) run by `sim`, this package's
+/// The firmware ELF on the SoC in the loop ([`MachineConfig::soc`]) run by `sim`, this package's
 /// binary `sc-soc-sim` (a test passes `env!("CARGO_BIN_EXE_sc-soc-sim")`: Cargo tells its
 /// path to integration tests only), or `None` after a loud `SKIPPED` line when the binary
 /// has no model ([`SOC_SKIP`]). Under `CI=true` the build has failed instead.
-pub fn soc_or_skip(test: &str, sim: impl Into<PathBuf>) -> Option<QemuConfig> {
+pub fn soc_or_skip(test: &str, sim: impl Into<PathBuf>) -> Option<MachineConfig> {
     if let Some(why) = SOC_SKIP {
         skip(test, &format!("sc-soc-sim has no SoC model: {why}"));
         return None;
     }
-    firmware_elf_or_skip(test).map(|elf| QemuConfig {
+    firmware_elf_or_skip(test).map(|elf| MachineConfig {
         soc: Some(sim.into()),
-        timeouts: QemuTimeouts::soc(),
-        ..QemuConfig::new(elf)
+        timeouts: MachineTimeouts::soc(),
+        ..MachineConfig::new(elf)
     })
 }
 

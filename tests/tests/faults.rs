@@ -19,7 +19,7 @@ use stereocal::session::SessionConfig;
 use stereocal_firmware::softcore::finisher::ExitCode;
 use stereocal_hil::{qemu_or_skip, run_qemu, soc_or_skip, Scenario};
 use stereocal_synth::SceneKind;
-use stereocal_tools::hil::{FirmwareExit, HilError, QemuConfig, QemuTimeouts, TimeoutKind};
+use stereocal_tools::hil::{FirmwareExit, HilError, MachineConfig, MachineTimeouts, TimeoutKind};
 
 /// `jal x0, 0`: jumps to itself.
 const HANG: u32 = 0x0000_006f;
@@ -27,7 +27,7 @@ const HANG: u32 = 0x0000_006f;
 const ECALL: u32 = 0x0000_0073;
 
 /// The patched function's mangled name: QEMU's or the SoC's (see the module docs).
-fn target(config: &QemuConfig) -> &'static str {
+fn target(config: &MachineConfig) -> &'static str {
     if config.soc.is_some() {
         "WiredFabric"
     } else {
@@ -62,9 +62,9 @@ fn patched(elf: &Path, part: &str, word: u32) -> tempfile::NamedTempFile {
 }
 
 /// Runs four 128x96 pairs on `config` with `word` patched in; the error and the wall time.
-fn run_faulty(config: &QemuConfig, word: u32) -> (HilError, Duration) {
+fn run_faulty(config: &MachineConfig, word: u32) -> (HilError, Duration) {
     let elf = patched(&config.elf, target(config), word);
-    let config = QemuConfig {
+    let config = MachineConfig {
         elf: elf.path().to_path_buf(),
         ..config.clone()
     };
@@ -135,7 +135,7 @@ fn soc_hung_firmware_is_ended_by_the_board_watchdog() {
     };
     assert_eq!(
         soc.timeouts,
-        QemuTimeouts::soc(),
+        MachineTimeouts::soc(),
         "{test}: the board's watchdog must be first"
     );
     let (err, took) = run_faulty(&soc, HANG);

@@ -22,12 +22,12 @@ use stereocal_hil::{
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig};
 use stereocal_tools::eval::{evaluate, EvalError};
 use stereocal_tools::hil::{
-    instruction_reports, kernel_report, run_on_qemu, run_sequence, FirmwareExit, GrabberInput,
-    HilError, QemuConfig, TimeoutKind,
+    instruction_reports, kernel_report, run_on_machine, run_sequence, FirmwareExit, GrabberInput,
+    HilError, MachineConfig, TimeoutKind,
 };
 
 /// Runs `scenario` both ways and checks bytes and records; prints the figures.
-fn compare(test: &str, qemu: &QemuConfig, scenario: &Scenario) {
+fn compare(test: &str, qemu: &MachineConfig, scenario: &Scenario) {
     let reference = run_in_process(scenario);
     let (on_qemu, run) = run_qemu(scenario, qemu).unwrap_or_else(|e| panic!("{test}: {e}"));
     assert!(run.end.exit.is_success(), "{test}: {}", run.end.exit);
@@ -161,7 +161,7 @@ fn qemu_instructions_per_pixel_640x240_are_deterministic() {
     let Some(qemu) = qemu_or_skip(test) else {
         return;
     };
-    let qemu = QemuConfig {
+    let qemu = MachineConfig {
         count_instructions: true,
         ..qemu
     };
@@ -222,7 +222,7 @@ fn softcore_budget(test: &str, sobel_output: SobelOutput) {
     let Some(qemu) = qemu_or_skip(test) else {
         return;
     };
-    let qemu = QemuConfig {
+    let qemu = MachineConfig {
         count_instructions: true,
         ..qemu
     };
@@ -274,7 +274,7 @@ fn qemu_firmware_failure_reports_exit_code_and_log() {
     // 128x96 images in the frame region, registers configured for 160x120.
     let mut input = GrabberInput::new(128, 96);
     input.push_pair(&[7; 128 * 96], &[9; 128 * 96], 0).unwrap();
-    let err = run_on_qemu(&qemu, &input, |device| {
+    let err = run_on_machine(&qemu, &input, |device| {
         let driver_error = |e| EvalError::Session(SessionError::Driver(e));
         let mut driver = Driver::new(device);
         let t = Duration::from_secs(30);
@@ -329,7 +329,7 @@ fn qemu_stack_high_water_640x480_rows_and_patches() {
         return;
     };
     // The stack report rides on the instruction-count flag, the run that logs measurements.
-    let qemu = QemuConfig {
+    let qemu = MachineConfig {
         count_instructions: true,
         ..qemu
     };

@@ -8,7 +8,10 @@
 //! (where the build already fails).
 
 // Without the RTL model only the skip path is compiled.
-#![cfg_attr(not(rtl_sim), allow(dead_code, unused_imports))]
+#![cfg_attr(
+    not(rtl_sim),
+    allow(dead_code, unused_imports, clippy::needless_return)
+)]
 
 /// Clocks per seed: about 80 frames each.
 const CLOCKS: u64 = 500_000;

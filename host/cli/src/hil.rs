@@ -11,7 +11,7 @@ use clap::Args;
 use stereocal::output::summary::{Residual, Summary};
 use stereocal_synth::{SceneKind, Sequence, SequenceConfig, TrajectoryKind};
 use stereocal_tools::hil::{
-    instruction_reports, kernel_report, run_sequence, QemuConfig, QemuTimeouts, SequenceRun,
+    instruction_reports, kernel_report, run_sequence, MachineConfig, MachineTimeouts, SequenceRun,
     SocReport, DEFAULT_QEMU,
 };
 
@@ -93,20 +93,20 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
         .map(|given| soc_simulator(given.as_deref()))
         .transpose()?;
     let defaults = if soc.is_some() {
-        QemuTimeouts::soc()
+        MachineTimeouts::soc()
     } else {
-        QemuTimeouts::default()
+        MachineTimeouts::default()
     };
-    let qemu = QemuConfig {
+    let qemu = MachineConfig {
         qemu: args.qemu.clone(),
         count_instructions: args.count_instructions,
         soc: soc.clone(),
         pixel_clock_divider: args.pixel_clock_divider,
-        timeouts: QemuTimeouts {
+        timeouts: MachineTimeouts {
             answer: args.timeout.map_or(defaults.answer, Duration::from_secs),
             ..defaults
         },
-        ..QemuConfig::new(&elf)
+        ..MachineConfig::new(&elf)
     };
 
     let machine = if soc.is_some() {

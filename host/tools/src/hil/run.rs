@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use super::device_log::{DeviceLog, LogDecoder};
-use super::qemu::{QemuConfig, QemuDevice, QemuEnd};
+use super::machine::{MachineConfig, MachineDevice, MachineEnd};
 use super::soc_report::SocReport;
 use super::stream_compare::{compare_streams, StreamMismatch};
 use super::{GrabberInput, HilError, TimeoutKind};
@@ -17,14 +17,14 @@ use stereocal_synth::Sequence;
 
 /// What a run on the machine gave.
 #[derive(Debug)]
-pub struct QemuRun<T> {
+pub struct MachineRun<T> {
     /// What the session computed.
     pub value: T,
     /// How the machine ended (success: every frame ran) and every byte the firmware sent.
-    pub end: QemuEnd,
+    pub end: MachineEnd,
     /// The firmware's logs, decoded with the ELF's defmt table.
     pub logs: Vec<DeviceLog>,
-    /// What the SoC in the loop's board measured ([`QemuConfig::soc`]); `None` under QEMU.
+    /// What the SoC in the loop's board measured ([`MachineConfig::soc`]); `None` under QEMU.
     pub board: Option<SocReport>,
 }
 
@@ -33,7 +33,7 @@ pub struct QemuRun<T> {
 #[derive(Debug)]
 pub struct SequenceRun {
     /// The run on the device: records and the session's cost.
-    pub device: QemuRun<(Vec<FrameRecord>, SessionCost)>,
+    pub device: MachineRun<(Vec<FrameRecord>, SessionCost)>,
     /// Whether the device's bytes after its `Hello` were the in-process device's; `None` when
     /// the firmware counted instructions (its reports are extra `Log` packets on the link).
     pub wire: Option<Result<(), StreamMismatch>>,
@@ -44,15 +44,15 @@ pub struct SequenceRun {
 /// Starts the machine on `config.elf` with `input` in its frame region, runs `session` on the
 /// device, and ends the machine: when `session` succeeds, by reading the UART to its end and
 /// requiring the firmware's success exit; otherwise by stopping it (see
-/// [`QemuDevice::abort`]) and returning the failure with the machine's status and the firmware's
+/// [`MachineDevice::abort`]) and returning the failure with the machine's status and the firmware's
 /// logs. An answer timeout inside the session is reported as [`HilError::Timeout`].
-pub fn run_on_qemu<T>(
-    config: &QemuConfig,
+pub fn run_on_machine<T>(
+    config: &MachineConfig,
     input: &GrabberInput,
-    session: impl FnOnce(&mut QemuDevice) -> Result<T, EvalError>,
-) -> Result<QemuRun<T>, HilError> {
+    session: impl FnOnce(&mut MachineDevice) -> Result<T, EvalError>,
+) -> Result<MachineRun<T>, HilError> {
     let decoder = LogDecoder::from_elf(&config.elf)?;
-    let mut device = QemuDevice::start(config, input)?;
+    let mut device = MachineDevice::start(config, input)?;
     match session(&mut device) {
         Ok(value) => {
             let end = device.finish()?;
@@ -64,7 +64,7 @@ pub fn run_on_qemu<T>(
                 });
             }
             let board = config.soc.is_some().then(|| SocReport::parse(&end.stderr));
-            Ok(QemuRun {
+            Ok(MachineRun {
                 value,
                 end,
                 logs,
@@ -109,7 +109,7 @@ pub fn run_on_qemu<T>(
 /// frame. Then the same frames on the in-process device, whose bytes and records the device's
 /// are compared with.
 pub fn run_sequence(
-    config: &QemuConfig,
+    config: &MachineConfig,
     sequence: &Sequence,
     session_config: SessionConfig,
     progress: &mut dyn FnMut(&FrameRecord),
@@ -132,7 +132,7 @@ pub fn run_sequence(
             )?;
         }
     }
-    let device = run_on_qemu(config, &input, |device| {
+    let device = run_on_machine(config, &input, |device| {
         let mut session = Session::with_device(device, calib, width, height, session_config)?;
         let records = evaluate_frames(
             &mut session,

@@ -1,8 +1,8 @@
-//! The firmware ELF on an emulated soft-core: `qemu-system-riscv32 -machine virt` as a
-//! [`Link`] with a [`FrameInput`].
+//! The firmware ELF on a simulated soft-core machine, `qemu-system-riscv32 -machine virt` or
+//! the SoC in the loop ([`MachineConfig::soc`]), as a [`Link`] with a [`FrameInput`].
 //!
-//! [`QemuDevice::start`] writes the pairs into a frame-grabber file, starts QEMU with that
-//! file loaded at the soft-core's frame region and the UART on a Unix socket, and connects to
+//! [`MachineDevice::start`] writes the pairs into a frame-grabber file, starts the machine with
+//! that file loaded at the soft-core's frame region and the UART on a Unix socket, and connects to
 //! the socket. From then on it is a link like any other: the host driver says Hello, writes
 //! the configuration, sets `CONTROL.ENABLE`, and reads the frames' packets. The command line:
 //!
@@ -14,12 +14,12 @@
 //! ```
 //! `wait=on` holds the machine until the host is connected, so no byte is lost; a socket and
 //! not `-nographic`, whose monitor multiplexer eats `0x01` bytes. `-icount shift=0` (with
-//! [`QemuConfig::count_instructions`]) makes `minstret` count retired instructions, one per
+//! [`MachineConfig::count_instructions`]) makes `minstret` count retired instructions, one per
 //! nanosecond of virtual time, so instruction counts are the same on every run.
 //!
-//! Every byte the UART sends is kept in a transcript. The run ends with [`QemuDevice::finish`]
+//! Every byte the UART sends is kept in a transcript. The run ends with [`MachineDevice::finish`]
 //! (read to the end, wait for the firmware's exit through the `sifive_test` finisher) or, on
-//! any error, [`QemuDevice::abort`]; dropping the device kills QEMU, so no error path leaves
+//! any error, [`MachineDevice::abort`]; dropping the device kills QEMU, so no error path leaves
 //! an emulator behind.
 
 use std::io::{self, Read};
@@ -37,7 +37,7 @@ use super::input::PairDigest;
 use super::{FirmwareExit, GrabberInput, HilError, TimeoutKind};
 use stereocal::link::{FrameInput, Link, LinkError, Recording, StreamLink, UnixLink};
 
-/// The emulator, found on `PATH` unless [`QemuConfig::qemu`] says otherwise.
+/// The emulator, found on `PATH` unless [`MachineConfig::qemu`] says otherwise.
 pub const DEFAULT_QEMU: &str = "qemu-system-riscv32";
 
 /// How often the host looks again at the socket (while QEMU starts) or the process (while it ends).
@@ -45,14 +45,14 @@ const POLL: Duration = Duration::from_millis(10);
 /// How long a firmware that failed gets to end the simulation itself before it is killed:
 /// its exit code says more than a kill does.
 const ABORT_GRACE: Duration = Duration::from_secs(1);
-/// How long [`QemuDevice::abort`] reads the bytes left in the socket.
+/// How long [`MachineDevice::abort`] reads the bytes left in the socket.
 const ABORT_DRAIN: Duration = Duration::from_millis(200);
 /// Bytes asked of the socket per read when draining it.
 const READ_CHUNK: usize = 64 * 1024;
 
 /// The timeouts of a run; an error names the one that fired ([`TimeoutKind`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct QemuTimeouts {
+pub struct MachineTimeouts {
     /// QEMU to open its UART socket.
     pub startup: Duration,
     /// One answer or one frame pair. A 640x480 pair takes a few seconds under QEMU's
@@ -68,7 +68,7 @@ pub struct QemuTimeouts {
     pub silence: Duration,
 }
 
-impl Default for QemuTimeouts {
+impl Default for MachineTimeouts {
     fn default() -> Self {
         Self {
             startup: Duration::from_secs(10),
@@ -79,7 +79,7 @@ impl Default for QemuTimeouts {
     }
 }
 
-impl QemuTimeouts {
+impl MachineTimeouts {
     /// The SoC in the loop's: an hour for an answer and for silence. A 640x480 pair is
     /// minutes of simulation there, and the board itself ends a firmware that hangs (its
     /// watchdog, after 400,000 clocks in which nothing moved), so the host's own limits
@@ -95,7 +95,7 @@ impl QemuTimeouts {
 
 /// How to run the firmware.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct QemuConfig {
+pub struct MachineConfig {
     /// The QEMU binary.
     pub qemu: PathBuf,
     /// The firmware ELF (`target/riscv32imc-unknown-none-elf/release/stereocal-firmware`).
@@ -115,10 +115,10 @@ pub struct QemuConfig {
     /// default (64, the stream engine's pace).
     pub pixel_clock_divider: Option<u32>,
     /// The timeouts.
-    pub timeouts: QemuTimeouts,
+    pub timeouts: MachineTimeouts,
 }
 
-impl QemuConfig {
+impl MachineConfig {
     /// The firmware at `elf`, the default QEMU and timeouts, no instruction counts.
     pub fn new(elf: impl Into<PathBuf>) -> Self {
         Self {
@@ -127,25 +127,25 @@ impl QemuConfig {
             count_instructions: false,
             soc: None,
             pixel_clock_divider: None,
-            timeouts: QemuTimeouts::default(),
+            timeouts: MachineTimeouts::default(),
         }
     }
 }
 
 /// How a run ended.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct QemuEnd {
-    /// QEMU's exit status, read as the firmware's exit code.
+pub struct MachineEnd {
+    /// The machine's exit status, read as the firmware's exit code.
     pub exit: FirmwareExit,
     /// Every byte the firmware sent on its UART.
     pub transcript: Vec<u8>,
-    /// What QEMU printed on stderr.
+    /// What the machine printed on stderr.
     pub stderr: String,
     /// The longest the device was silent while the host waited for it.
     pub longest_silence: Duration,
 }
 
-/// The QEMU process; dropping it kills a QEMU that is still running.
+/// The machine's process; dropping it kills a machine that is still running.
 struct Process {
     child: Child,
     stderr: Option<JoinHandle<String>>,
@@ -209,28 +209,28 @@ impl Drop for Process {
     }
 }
 
-/// The firmware under QEMU, connected over the UART socket.
-pub struct QemuDevice {
-    // Field order is drop order: the link closes, QEMU is killed, then the directory with
+/// The firmware on a machine (QEMU or the SoC simulator), connected over the UART socket.
+pub struct MachineDevice {
+    // Field order is drop order: the link closes, the machine is killed, then the directory with
     // the socket and the frame file goes.
     link: Recording<UnixLink>,
     process: Process,
     loaded: Vec<PairDigest>,
     submitted: usize,
-    timeouts: QemuTimeouts,
+    timeouts: MachineTimeouts,
     /// When the host began waiting without getting a byte since.
     quiet_since: Option<Instant>,
     /// The longest silence so far.
     longest_silence: Duration,
-    /// Set once the device has been silent for [`QemuTimeouts::silence`].
+    /// Set once the device has been silent for [`MachineTimeouts::silence`].
     silent: Option<Duration>,
     _dir: tempfile::TempDir,
 }
 
-impl QemuDevice {
+impl MachineDevice {
     /// Writes `input` into a frame-grabber file, starts QEMU on `config.elf` with it and
     /// connects to the UART. The firmware then waits for the host's Hello and configuration.
-    pub fn start(config: &QemuConfig, input: &GrabberInput) -> Result<Self, HilError> {
+    pub fn start(config: &MachineConfig, input: &GrabberInput) -> Result<Self, HilError> {
         let elf_readable = std::fs::File::open(&config.elf).map(drop);
         elf_readable.map_err(|source| HilError::File {
             path: config.elf.clone(),
@@ -343,8 +343,8 @@ impl QemuDevice {
     }
 
     /// Ends a run that went well: reads the UART to its end and waits for the firmware to
-    /// end the simulation ([`QemuTimeouts::exit`]).
-    pub fn finish(mut self) -> Result<QemuEnd, HilError> {
+    /// end the simulation ([`MachineTimeouts::exit`]).
+    pub fn finish(mut self) -> Result<MachineEnd, HilError> {
         let limit = self.timeouts.exit;
         let deadline = Instant::now() + limit;
         let timeout = |waiting_for: &str| HilError::Timeout {
@@ -370,7 +370,7 @@ impl QemuDevice {
             .process
             .wait_until(deadline)
             .ok_or_else(|| timeout("QEMU to exit after its UART closed"))?;
-        Ok(QemuEnd {
+        Ok(MachineEnd {
             exit,
             transcript: self.link.take_received(),
             stderr: self.process.stderr(),
@@ -380,7 +380,7 @@ impl QemuDevice {
 
     /// Ends a run that failed: gives a failing firmware a moment to end the simulation with
     /// its own exit code, kills QEMU otherwise, and keeps the bytes it had sent.
-    pub fn abort(mut self) -> QemuEnd {
+    pub fn abort(mut self) -> MachineEnd {
         let exit = self
             .process
             .wait_until(Instant::now() + ABORT_GRACE)
@@ -388,7 +388,7 @@ impl QemuDevice {
         let deadline = Instant::now() + ABORT_DRAIN;
         let mut buf = vec![0; READ_CHUNK];
         while self.recv(&mut buf, deadline).is_ok() {}
-        QemuEnd {
+        MachineEnd {
             exit,
             transcript: self.link.take_received(),
             stderr: self.process.stderr(),
@@ -402,12 +402,12 @@ fn option_value(path: &Path) -> String {
     path.display().to_string().replace(',', ",,")
 }
 
-impl Link for QemuDevice {
+impl Link for MachineDevice {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         self.link.send(bytes)
     }
 
-    /// A device that sends nothing for [`QemuTimeouts::silence`] hangs (or its machine
+    /// A device that sends nothing for [`MachineTimeouts::silence`] hangs (or its machine
     /// stopped): from then on every receive fails at once with an error, not a timeout, so
     /// the session stops instead of waiting its answer timeout for every remaining frame.
     fn recv(&mut self, buf: &mut [u8], deadline: Instant) -> Result<usize, LinkError> {
@@ -441,7 +441,7 @@ impl Link for QemuDevice {
     }
 }
 
-impl FrameInput for QemuDevice {
+impl FrameInput for MachineDevice {
     /// The pairs were loaded at boot; this only checks that the host asks for the pair the
     /// firmware will run next, so host records and device frames cannot drift apart.
     fn submit_pair(
@@ -471,7 +471,7 @@ impl FrameInput for QemuDevice {
 }
 
 /// QEMU's command line (the module docs).
-fn qemu_command(config: &QemuConfig, socket: &Path, frames: &Path) -> Command {
+fn qemu_command(config: &MachineConfig, socket: &Path, frames: &Path) -> Command {
     let mut command = Command::new(&config.qemu);
     command
         .args(["-machine", "virt", "-m", "128M", "-bios", "none"])
@@ -497,7 +497,7 @@ fn qemu_command(config: &QemuConfig, socket: &Path, frames: &Path) -> Command {
 
 /// The SoC simulator's command line (`hdl-interface/soc/sim/sc_soc_sim.cpp`): the same ELF,
 /// frame file and socket as QEMU's.
-fn soc_command(sim: &Path, config: &QemuConfig, socket: &Path, frames: &Path) -> Command {
+fn soc_command(sim: &Path, config: &MachineConfig, socket: &Path, frames: &Path) -> Command {
     let mut command = Command::new(sim);
     command
         .arg("--elf")
@@ -528,11 +528,11 @@ mod tests {
     #[test]
     fn a_missing_emulator_is_named() {
         let elf = tempfile::NamedTempFile::new().unwrap();
-        let config = QemuConfig {
+        let config = MachineConfig {
             qemu: "/nonexistent/qemu-system-riscv32".into(),
-            ..QemuConfig::new(elf.path())
+            ..MachineConfig::new(elf.path())
         };
-        let err = QemuDevice::start(&config, &GrabberInput::new(4, 2))
+        let err = MachineDevice::start(&config, &GrabberInput::new(4, 2))
             .err()
             .unwrap();
         assert!(matches!(err, HilError::Spawn { .. }), "{err}");
