@@ -130,6 +130,8 @@ fn run_on_each_format_estimates_what_run_on_the_toml_does() {
             seq.join("right").to_str().unwrap(),
             "--calib",
             fixture(calib).to_str().unwrap(),
+            "--truth",
+            seq.join("truth.csv").to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
             "--json",
@@ -139,6 +141,21 @@ fn run_on_each_format_estimates_what_run_on_the_toml_does() {
         std::fs::read_to_string(out.join("verge.csv")).unwrap()
     };
     let toml = run("road.toml");
+    // `verge.csv` carries the truth it was given, to its 6 decimals.
+    let truth = std::fs::read_to_string(seq.join("truth.csv")).unwrap();
+    let column = |text: &str, name: &str| -> Vec<f64> {
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let at = header.iter().position(|h| *h == name).unwrap();
+        lines
+            .map(|l| l.split(',').nth(at).unwrap().parse().unwrap())
+            .collect()
+    };
+    let (given, written) = (column(&truth, "verge_deg"), column(&toml, "truth_deg"));
+    assert_eq!(given.len(), written.len(), "{toml}");
+    for (g, w) in given.iter().zip(&written) {
+        assert!((g - w).abs() <= 5e-7, "truth {g}, verge.csv {w}:\n{toml}");
+    }
     for calib in [
         "road-opencv.yml",
         "road-opencv.json",

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::output::record::FrameRecord;
 
 /// Header of `verge.csv`; part of the CLI contract, never reordered (new columns go last).
-pub const VERGE_HEADER: [&str; 12] = [
+pub const VERGE_HEADER: [&str; 13] = [
     "frame",
     "raw_verge_deg",
     "filtered_verge_deg",
@@ -20,6 +20,7 @@ pub const VERGE_HEADER: [&str; 12] = [
     "baseline_tilt_deg",
     "packets_lost",
     "keypoints_lost",
+    "truth_deg",
 ];
 
 /// Header of a ground-truth file.
@@ -86,6 +87,7 @@ pub fn write_verge_csv<W: Write>(out: W, records: &[FrameRecord]) -> Result<(), 
             angle(r.misalignment.map(|m| m.baseline_tilt_deg)),
             r.link_loss.map_or(0, |l| l.packets_lost).to_string(),
             r.link_loss.map_or(0, |l| l.keypoints_lost).to_string(),
+            angle(r.truth_deg),
         ])?;
     }
     w.flush()?;
@@ -169,7 +171,7 @@ mod tests {
                 keypoints_per_octave: Vec::new(),
                 matches_per_octave: Vec::new(),
                 status: FrameStatus::Ok,
-                truth_deg: None,
+                truth_deg: Some(1.3),
                 dropped_because: None,
                 misalignment: Some(MisalignmentEstimate {
                     pitch_deg: 0.01,
@@ -224,10 +226,10 @@ mod tests {
         assert_eq!(
             text,
             "frame,raw_verge_deg,filtered_verge_deg,filtered_sigma_deg,matches,inliers,status,\
-             pitch_deg,roll_deg,baseline_tilt_deg,packets_lost,keypoints_lost\n\
-             0,1.250000,1.200000,0.010000,40,38,ok,0.010000,-0.030000,0.000000,0,0\n\
-             1,,,,2,0,no_estimate,,,,0,0\n\
-             2,1.500000,1.300000,0.010000,30,29,salvaged,,,,3,7\n"
+             pitch_deg,roll_deg,baseline_tilt_deg,packets_lost,keypoints_lost,truth_deg\n\
+             0,1.250000,1.200000,0.010000,40,38,ok,0.010000,-0.030000,0.000000,0,0,1.300000\n\
+             1,,,,2,0,no_estimate,,,,0,0,\n\
+             2,1.500000,1.300000,0.010000,30,29,salvaged,,,,3,7,\n"
         );
     }
 
