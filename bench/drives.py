@@ -42,12 +42,22 @@ Figures, per method, over the frames it estimated (truth_i is the injected verge
   after its start-up (`filtered_span_deg`), and of each method's raw estimates over all frames.
 * estimated: frames with an estimate / frames.
 
+With --crop-reference a second table says how much of the differential is the injection's crop
+rather than its verge: `stereocal inject` keeps only the window every injected frame fills
+(smaller the larger the yaws), so the injected frames see less of the scene than the untouched
+ones, whatever the verge. For each trajectory the untouched frames are cropped to that window
+(the injected calib.toml's principal point says where it lies) and both methods run on them:
+*crop alone* is |cropped_i - untouched_i| (no warp, no verge: the window's effect alone), and
+*differential, cropped reference* is |est_i - cropped_i - truth_i|, the differential against
+an untouched run that sees the same window.
+
 The first run makes bench/.venv (python3 -m venv) and installs numpy, opencv-python-headless
 and scipy into it; the script then re-runs itself inside that venv.
 
-Usage: bench/drives.py [--keep] [--csv DIR] [-- RUN_ARGS...]
+Usage: bench/drives.py [--keep] [--csv DIR] [--crop-reference] [-- RUN_ARGS...]
   --keep      keep the work directory (injected sequences, verge.csv files)
   --csv DIR   write per-frame CSVs (sequence_trajectory.csv) into DIR for further analysis
+  --crop-reference  also run the untouched frames cropped to each trajectory's window
   RUN_ARGS    extra flags for every `stereocal run` (e.g. -- --model general)
 """
 
@@ -285,6 +295,41 @@ def rectified_sequences(data):
     return found
 
 
+def crop_reference(seq, src, inj_calib, work_dir):
+    """The untouched frames of `src` cropped to the window of the injected sequence `seq`
+    (its calib.toml's principal point less the source's gives the window's corner, its images
+    the size), written with the injected calib.toml into `work_dir`; returns that directory."""
+    import cv2
+    import shutil
+    cal_src, cal_inj = read_calib(os.path.join(src, "calib.toml")), read_calib(inj_calib)
+    x0 = round(cal_src["left"]["cx"] - cal_inj["left"]["cx"])
+    y0 = round(cal_src["left"]["cy"] - cal_inj["left"]["cy"])
+    for side in ("left", "right"):
+        names = sorted(os.listdir(os.path.join(seq, side)))
+        h, w = cv2.imread(os.path.join(seq, side, names[0]), cv2.IMREAD_GRAYSCALE).shape
+        os.makedirs(os.path.join(work_dir, side))
+        for name in sorted(os.listdir(os.path.join(src, side))):
+            img = cv2.imread(os.path.join(src, side, name), cv2.IMREAD_GRAYSCALE)
+            if img is None or img.shape[0] < y0 + h or img.shape[1] < x0 + w or min(x0, y0) < 0:
+                raise SystemExit(f"cannot crop {side}/{name} to the {w}x{h} window at "
+                                 f"({x0}, {y0})")
+            out = os.path.join(work_dir, side, os.path.splitext(name)[0] + ".png")
+            cv2.imwrite(out, img[y0:y0 + h, x0:x0 + w])
+    shutil.copy(inj_calib, os.path.join(work_dir, "calib.toml"))
+    return work_dir, (x0, y0, w, h)
+
+
+def crop_figures(est, cropped, untouched, truth):
+    """Crop alone and the differential against the cropped reference (None = no estimate)."""
+    import numpy as np
+    alone = [abs(c - u) for c, u in zip(cropped, untouched) if c is not None and u is not None]
+    df = [abs(e - c - t) for e, c, t in zip(est, cropped, truth)
+          if e is not None and c is not None]
+    med = lambda v: float(np.median(v)) if v else None
+    return {"alone_median": med(alone), "alone_max": max(alone) if alone else None,
+            "diff_median": med(df), "diff_max": max(df) if df else None}
+
+
 def write_frames_csv(path, truth, ours, ours_u, sift, sift_u):
     import csv
     with open(path, "w", newline="") as f:
@@ -312,6 +357,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--keep", action="store_true", help="keep the work directory")
     ap.add_argument("--csv", help="write per-frame CSVs into this directory")
+    ap.add_argument("--crop-reference", action="store_true",
+                    help="also run the untouched frames cropped to each trajectory's window")
     args = ap.parse_args(argv)
 
     data = os.environ.get("STEREOCAL_REAL_DATA", os.path.join(ROOT, "..", "shared", "data", "real"))
@@ -324,7 +371,7 @@ def main():
         os.makedirs(args.csv, exist_ok=True)
 
     work = tempfile.mkdtemp(prefix="drives.")
-    rows = []
+    rows, crops = [], []
     try:
         sign_check(binary, work)
         for name, d in rectified_sequences(data):
@@ -358,6 +405,18 @@ def main():
                 if args.csv:
                     write_frames_csv(os.path.join(args.csv, f"{name}_{traj}.csv"), truth, ours,
                                      ours_u, sift, sift_u)
+                if args.crop_reference:
+                    print(f"{name}: untouched, cropped to {traj}'s window", file=sys.stderr)
+                    ref, window = crop_reference(seq, d, os.path.join(seq, "calib.toml"),
+                                                 os.path.join(work, f"{name}_{traj}_cropped"))
+                    rl, rr, rc = (os.path.join(ref, p) for p in ("left", "right", "calib.toml"))
+                    ours_c, _ = run_ours(binary, rl, rr, rc, ref + "_out", run_args)
+                    sift_c = run_sift(rl, rr, rc)
+                    crops.append((name, traj, window,
+                                  crop_figures([r["raw"] for r in ours],
+                                               [r["raw"] for r in ours_c], ou, truth),
+                                  crop_figures([r["raw"] for r in sift],
+                                               [r["raw"] for r in sift_c], su, truth)))
             if args.csv:
                 write_frames_csv(os.path.join(args.csv, f"{name}_untouched.csv"), [0.0] * n,
                                  ours_u, ours_u, sift_u, sift_u)
@@ -395,6 +454,17 @@ def main():
     print(f"\nOn the untouched rows the absolute figures are the scatter of the raw estimate "
           f"about its own median and the spans are those of the untouched drive (the rig holds "
           f"its verge). Machine: {platform.machine()}, {os.cpu_count()} cores.")
+    if crops:
+        print("\nThe injection's crop (--crop-reference): the untouched frames cropped to each "
+              "trajectory's window. Degrees; ours / SIFT.\n")
+        print("| sequence | trajectory | window (x, y, width x height) | crop alone: median "
+              "| crop alone: max | differential, cropped reference: median | differential, "
+              "cropped reference: max |")
+        print("|---|---|---|---|---|---|---|")
+        for name, traj, (x0, y0, w, h), o, s in crops:
+            both = lambda k: f"{f(o[k])} / {f(s[k])}"
+            print(f"| {name} | {traj} | {x0}, {y0}, {w}x{h} | {both('alone_median')} "
+                  f"| {both('alone_max')} | {both('diff_median')} | {both('diff_max')} |")
 
 
 if __name__ == "__main__":
