@@ -52,6 +52,19 @@ impl Default for SessionConfig {
     }
 }
 
+impl SessionConfig {
+    /// The defaults with each frame estimated alone (no misalignment window): a window's
+    /// estimate of a pair depends on the frames before it, so only per-frame estimates let a
+    /// run that lost or damaged some frames give every intact pair the clean run's verge to
+    /// the bit.
+    pub fn per_frame() -> Self {
+        Self {
+            misalignment: None,
+            ..Self::default()
+        }
+    }
+}
+
 /// The fabric configuration a session writes for `width` x `height` frames: the register
 /// defaults with the host's contrast threshold (the type, `FabricConfig`, is the map's).
 ///

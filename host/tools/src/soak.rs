@@ -170,13 +170,8 @@ pub fn soak(config: SoakConfig, progress: &dyn Fn(usize)) -> Result<Soak, SoakEr
         workload.calib,
     );
 
-    // Each frame alone: a misalignment window's estimate of a pair depends on the frames
-    // before it, which the faults change, so only per-frame estimates make an intact pair's
-    // verge the clean run's to the bit.
-    let per_frame = SessionConfig {
-        misalignment: None,
-        ..SessionConfig::default()
-    };
+    // The faults change which frames come before a pair.
+    let per_frame = SessionConfig::per_frame();
     // The clean reference: each rendered pair once, without faults.
     let mut clean = Session::with_device(InProcessLink::new()?, calib, w, h, per_frame)?;
     let mut reference = Vec::with_capacity(workload.len());

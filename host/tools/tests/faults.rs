@@ -197,12 +197,8 @@ fn a_session_over_a_damaging_link_drops_frames_and_keeps_estimates_exact() {
     let run = |faults: FaultConfig| -> Vec<FrameRecord> {
         let mut link = FaultLink::new(InProcessLink::new().unwrap(), faults).unwrap();
         link.set_active(false);
-        // Each frame alone: a misalignment window's estimate depends on the frames before
-        // it, which the burst drops, and the frames after the burst must match the clean run.
-        let per_frame = SessionConfig {
-            misalignment: None,
-            ..SessionConfig::default()
-        };
+        // The burst drops frames that come before the ones after it.
+        let per_frame = SessionConfig::per_frame();
         let mut session = Session::with_device(link, calib, 320, 240, per_frame).unwrap();
         frames
             .iter()
