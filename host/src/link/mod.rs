@@ -15,7 +15,7 @@
 //! | Unix socket (QEMU `-chardev socket,path=..`) | [`UnixLink`] | [`StreamLink::unix`] |
 //! | a byte capture played back | [`ReplayLink`] | [`ReplayLink::new`], [`ReplayLink::from_file`] |
 //! | any link above, its received bytes damaged by seed | [`FaultLink`] | [`FaultLink::new`] |
-//! | the firmware ELF under `qemu-system-riscv32` | `MachineDevice` (`stereocal-tools`) | `MachineDevice::start` |
+//! | the firmware ELF under `qemu-system-riscv32`, or on the SoC simulator `sc-soc-sim` | `MachineDevice` (`stereocal-tools`) | `MachineDevice::start` |
 //!
 //! A device whose pixels the host provides also has a [`FrameInput`]; a head that grabs its
 //! own frames (a board, an emulator started by hand) has only its link, named and timed by
