@@ -298,7 +298,8 @@ def rectified_sequences(data):
 def crop_reference(seq, src, inj_calib, work_dir):
     """The untouched frames of `src` cropped to the window of the injected sequence `seq`
     (its calib.toml's principal point less the source's gives the window's corner, its images
-    the size), written with the injected calib.toml into `work_dir`; returns that directory."""
+    the size), written with the injected calib.toml into `work_dir`; returns that directory
+    and the window (x, y, width, height)."""
     import cv2
     import shutil
     cal_src, cal_inj = read_calib(os.path.join(src, "calib.toml")), read_calib(inj_calib)
@@ -317,17 +318,6 @@ def crop_reference(seq, src, inj_calib, work_dir):
             cv2.imwrite(out, img[y0:y0 + h, x0:x0 + w])
     shutil.copy(inj_calib, os.path.join(work_dir, "calib.toml"))
     return work_dir, (x0, y0, w, h)
-
-
-def crop_figures(est, cropped, untouched, truth):
-    """Crop alone and the differential against the cropped reference (None = no estimate)."""
-    import numpy as np
-    alone = [abs(c - u) for c, u in zip(cropped, untouched) if c is not None and u is not None]
-    df = [abs(e - c - t) for e, c, t in zip(est, cropped, truth)
-          if e is not None and c is not None]
-    med = lambda v: float(np.median(v)) if v else None
-    return {"alone_median": med(alone), "alone_max": max(alone) if alone else None,
-            "diff_median": med(df), "diff_max": max(df) if df else None}
 
 
 def write_frames_csv(path, truth, ours, ours_u, sift, sift_u):
@@ -412,11 +402,13 @@ def main():
                     rl, rr, rc = (os.path.join(ref, p) for p in ("left", "right", "calib.toml"))
                     ours_c, _ = run_ours(binary, rl, rr, rc, ref + "_out", run_args)
                     sift_c = run_sift(rl, rr, rc)
+                    # Crop alone: the cropped run against the untouched one, no verge
+                    # injected; then the differential with the cropped run as reference.
+                    oc, sc = [r["raw"] for r in ours_c], [r["raw"] for r in sift_c]
                     crops.append((name, traj, window,
-                                  crop_figures([r["raw"] for r in ours],
-                                               [r["raw"] for r in ours_c], ou, truth),
-                                  crop_figures([r["raw"] for r in sift],
-                                               [r["raw"] for r in sift_c], su, truth)))
+                                  figures(oc, ou, zero), figures(sc, su, zero),
+                                  figures([r["raw"] for r in ours], oc, truth),
+                                  figures([r["raw"] for r in sift], sc, truth)))
             if args.csv:
                 write_frames_csv(os.path.join(args.csv, f"{name}_untouched.csv"), [0.0] * n,
                                  ours_u, ours_u, sift_u, sift_u)
@@ -461,10 +453,11 @@ def main():
               "| crop alone: max | differential, cropped reference: median | differential, "
               "cropped reference: max |")
         print("|---|---|---|---|---|---|---|")
-        for name, traj, (x0, y0, w, h), o, s in crops:
-            both = lambda k: f"{f(o[k])} / {f(s[k])}"
-            print(f"| {name} | {traj} | {x0}, {y0}, {w}x{h} | {both('alone_median')} "
-                  f"| {both('alone_max')} | {both('diff_median')} | {both('diff_max')} |")
+        for name, traj, (x0, y0, w, h), oa, sa, od, sd in crops:
+            both = lambda o, s, k: f"{f(o[k])} / {f(s[k])}"
+            print(f"| {name} | {traj} | {x0}, {y0}, {w}x{h} "
+                  f"| {both(oa, sa, 'diff_median')} | {both(oa, sa, 'diff_max')} "
+                  f"| {both(od, sd, 'diff_median')} | {both(od, sd, 'diff_max')} |")
 
 
 if __name__ == "__main__":

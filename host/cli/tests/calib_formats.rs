@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use stereocal::calib::{Calibration, Extrinsics};
+use stereocal::output::verge_csv::read_truth_csv;
 
 const BIN: &str = env!("CARGO_BIN_EXE_stereocal");
 
@@ -142,16 +143,13 @@ fn run_on_each_format_estimates_what_run_on_the_toml_does() {
     };
     let toml = run("road.toml");
     // `verge.csv` carries the truth it was given, to its 6 decimals.
-    let truth = std::fs::read_to_string(seq.join("truth.csv")).unwrap();
-    let column = |text: &str, name: &str| -> Vec<f64> {
-        let mut lines = text.lines();
-        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-        let at = header.iter().position(|h| *h == name).unwrap();
-        lines
-            .map(|l| l.split(',').nth(at).unwrap().parse().unwrap())
-            .collect()
-    };
-    let (given, written) = (column(&truth, "verge_deg"), column(&toml, "truth_deg"));
+    let given = read_truth_csv(&seq.join("truth.csv")).unwrap();
+    let mut lines = toml.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = header.iter().position(|h| *h == "truth_deg").unwrap();
+    let written: Vec<f64> = lines
+        .map(|l| l.split(',').nth(at).unwrap().parse().unwrap())
+        .collect();
     assert_eq!(given.len(), written.len(), "{toml}");
     for (g, w) in given.iter().zip(&written) {
         assert!((g - w).abs() <= 5e-7, "truth {g}, verge.csv {w}:\n{toml}");

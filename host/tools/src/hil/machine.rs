@@ -1,9 +1,9 @@
 //! The firmware ELF on a simulated soft-core machine, `qemu-system-riscv32 -machine virt` or
 //! the SoC in the loop ([`MachineConfig::soc`]), as a [`Link`] with a [`FrameInput`].
 //!
-//! [`MachineDevice::start`] writes the pairs into a frame-grabber file, starts the machine with
-//! that file loaded at the soft-core's frame region and the UART on a Unix socket, and connects to
-//! the socket. From then on it is a link like any other: the host driver says Hello, writes
+//! [`MachineDevice::start`] writes the pairs into a frame-grabber file, starts the machine
+//! with that file loaded at the soft-core's frame region and the UART on a Unix socket, and
+//! connects to the socket. From then on it is a link like any other: the host driver says Hello, writes
 //! the configuration, sets `CONTROL.ENABLE`, and reads the frames' packets. The command line:
 //!
 //! ```text
@@ -17,10 +17,10 @@
 //! [`MachineConfig::count_instructions`]) makes `minstret` count retired instructions, one per
 //! nanosecond of virtual time, so instruction counts are the same on every run.
 //!
-//! Every byte the UART sends is kept in a transcript. The run ends with [`MachineDevice::finish`]
-//! (read to the end, wait for the firmware's exit through the `sifive_test` finisher) or, on
-//! any error, [`MachineDevice::abort`]; dropping the device kills QEMU, so no error path leaves
-//! an emulator behind.
+//! Every byte the UART sends is kept in a transcript. The run ends with
+//! [`MachineDevice::finish`] (read to the end, wait for the firmware's exit through the
+//! `sifive_test` finisher) or, on any error, [`MachineDevice::abort`]; dropping the device
+//! kills the machine, so no error path leaves an emulator or a simulator behind.
 
 use std::io::{self, Read};
 use std::os::unix::net::UnixStream;
@@ -211,8 +211,8 @@ impl Drop for Process {
 
 /// The firmware on a machine (QEMU or the SoC simulator), connected over the UART socket.
 pub struct MachineDevice {
-    // Field order is drop order: the link closes, the machine is killed, then the directory with
-    // the socket and the frame file goes.
+    // Field order is drop order: the link closes, the machine is killed, then the directory
+    // with the socket and the frame file goes.
     link: Recording<UnixLink>,
     process: Process,
     loaded: Vec<PairDigest>,
