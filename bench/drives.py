@@ -16,8 +16,9 @@ one injected sequence per trajectory (`moving`: verge about +-3 deg, cameras on 
 sinusoids; `fixed`: verge 1.5 deg while the head turns +-1 deg; `swing`: verge +-10 deg), and
 both methods run on each:
 
-* stereocal: `stereocal run --json --out DIR` (default settings, or those given after `--`);
-  the per-frame raw verge comes from DIR/verge.csv, the filtered span from the JSON.
+* stereocal: `stereocal run --json --out DIR` (default settings, or those given after `--`)
+  at the sequence's frame rate (FRAME_RATES below, unless `--fps` is given after `--`); the
+  per-frame raw verge comes from DIR/verge.csv, the filtered span from the JSON.
 * SIFT verge-only fit: cv2.SIFT_create() on both images, BFMatcher L2 k=2 with Lowe's ratio
   test at 0.8 (as bench/compare_opencv.py), then the same pure-verge model stereocal's default
   fits: each camera yaws about its own y axis, E(a_l, a_r) = Ry(a_r)^T [t]x Ry(a_l) with
@@ -74,6 +75,11 @@ RATIO = 0.8  # Lowe's ratio for SIFT, as in bench/compare_opencv.py
 RANSAC_DRAWS = 500
 RANSAC_PX = 1.0  # inlier threshold, Sampson distance in pixels
 HUBER_PX = 0.5  # where the refinement's loss turns from quadratic to linear
+# The rate each sequence was recorded at, which `stereocal run --fps` turns into the filter's
+# time between frames. KITTI's cameras are triggered by its laser scanner at 10 frames a second
+# (Geiger, Lenz, Stiller, Urtasun: "Vision meets Robotics: The KITTI Dataset", IJRR 2013).
+# A sequence not listed runs at `stereocal run`'s default, and the script says so.
+FRAME_RATES = {"kitti_odometry_drive": 10.0}
 # Issue 21 item 2 (degrees, percent): printed beside the figures for reference.
 TARGETS = {"abs_median": 0.02, "abs_max": 0.08, "diff_median": 0.01, "diff_max": 0.04,
            "span": 0.05, "swing_median": 0.04, "swing_max": 0.15, "estimated": 98.0}
@@ -361,14 +367,22 @@ def main():
         os.makedirs(args.csv, exist_ok=True)
 
     work = tempfile.mkdtemp(prefix="drives.")
-    rows, crops = [], []
+    rows, crops, rates = [], [], []
     try:
         sign_check(binary, work)
         for name, d in rectified_sequences(data):
             print(f"{name}: untouched", file=sys.stderr)
+            seq_args = run_args
+            if "--fps" not in run_args:
+                if name in FRAME_RATES:
+                    seq_args = ["--fps", f"{FRAME_RATES[name]:g}", *run_args]
+                    rates.append(f"{name} {FRAME_RATES[name]:g} fps")
+                else:
+                    print(f"{name}: frame rate unknown, `stereocal run`'s default",
+                          file=sys.stderr)
             left, right, calib = (os.path.join(d, p) for p in ("left", "right", "calib.toml"))
             ours_u, sum_u = run_ours(binary, left, right, calib,
-                                     os.path.join(work, f"{name}_untouched_out"), run_args)
+                                     os.path.join(work, f"{name}_untouched_out"), seq_args)
             sift_u = run_sift(left, right, calib)
             n = len(ours_u)
             zero = [0.0] * n
@@ -384,7 +398,7 @@ def main():
                 ours, summ = run_ours(binary, os.path.join(seq, "left"),
                                       os.path.join(seq, "right"),
                                       os.path.join(seq, "calib.toml"),
-                                      os.path.join(work, f"{name}_{traj}_out"), run_args,
+                                      os.path.join(work, f"{name}_{traj}_out"), seq_args,
                                       truth=os.path.join(seq, "truth.csv"))
                 sift = run_sift(os.path.join(seq, "left"), os.path.join(seq, "right"),
                                 os.path.join(seq, "calib.toml"))
@@ -400,7 +414,7 @@ def main():
                     ref, window = crop_reference(seq, d, os.path.join(seq, "calib.toml"),
                                                  os.path.join(work, f"{name}_{traj}_cropped"))
                     rl, rr, rc = (os.path.join(ref, p) for p in ("left", "right", "calib.toml"))
-                    ours_c, _ = run_ours(binary, rl, rr, rc, ref + "_out", run_args)
+                    ours_c, _ = run_ours(binary, rl, rr, rc, ref + "_out", seq_args)
                     sift_c = run_sift(rl, rr, rc)
                     # Crop alone: the cropped run against the untouched one, no verge
                     # injected; then the differential with the cropped run as reference.
@@ -445,7 +459,8 @@ def main():
           f"| ≤ {t['diff_max']}° | ≤ {t['span']}° | - | - |")
     print(f"\nOn the untouched rows the absolute figures are the scatter of the raw estimate "
           f"about its own median and the spans are those of the untouched drive (the rig holds "
-          f"its verge). Machine: {platform.machine()}, {os.cpu_count()} cores.")
+          f"its verge). Frame rates (`--fps`): {', '.join(rates) or 'as given'}. "
+          f"Machine: {platform.machine()}, {os.cpu_count()} cores.")
     if crops:
         print("\nThe injection's crop (--crop-reference): the untouched frames cropped to each "
               "trajectory's window. Degrees; ours / SIFT.\n")

@@ -41,6 +41,17 @@
 //! moved by it in the prediction, so a move is predicted rather than detected, and a still
 //! model stays right through it (the verge the images measure is the encoders' plus the
 //! calibration's slowly drifting offset, which is what the still model then tracks).
+//!
+//! The estimator's σ counts only its matches' noise. On rendered frames that is the whole
+//! error; on real ones the error also carries a part that follows the view (geometry beyond
+//! the model, bent differently by each view's matches), which no number of matches lowers.
+//! Trusting the matches' σ there makes every few-frame excursion of that part look like a
+//! move, and the filter follows it. So the filter learns how far off its measurements really
+//! are: the median of the still model's squared normalised innovations over the last still
+//! frames, against the median a correct σ gives (χ² with one degree of freedom), scales the
+//! measurement σ up (never down: where the σ is right, nothing changes).
+
+use std::collections::VecDeque;
 
 use nalgebra::{Matrix2, Vector2};
 
@@ -65,6 +76,9 @@ pub struct KalmanConfig {
     /// Degrees of freedom of the Student-t innovation likelihood that weighs the two models
     /// (`f64::INFINITY`: Gaussian).
     pub likelihood_dof: f64,
+    /// Still frames whose innovations set the measurement-noise scale (module doc); 0 keeps
+    /// the estimator's σ as it is.
+    pub noise_scale_frames: usize,
 }
 
 impl Default for KalmanConfig {
@@ -97,9 +111,22 @@ impl Default for KalmanConfig {
             // probability below one half, where a Gaussian makes it over 0.8
             // (`one_outlying_frame_does_not_switch_a_still_head_to_turning`).
             likelihood_dof: 8.0,
+            // The misalignment window's 30 frames, for the same reasons: the scale's relative
+            // noise (about 1.17/√n, see `NOISE_SCALE_MIN_FRAMES`) is about a fifth at 30, and
+            // the part of the error that follows the view changes as a drive goes on.
+            noise_scale_frames: 30,
         }
     }
 }
+
+/// Median of χ² with one degree of freedom: the median squared normalised innovation when the
+/// measurement σ is right.
+const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
+
+/// Innovations the noise scale needs before it is used. A scale from the median of n squared
+/// innovations has a relative noise of about 1.17/√n (as a MAD has), over a third below 12:
+/// the bar the estimator's `min_matches` sets for its own σ.
+const NOISE_SCALE_MIN_FRAMES: usize = 12;
 
 /// One per-frame verge measurement.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -192,6 +219,11 @@ pub struct VergeFilter {
     fallback: Option<State>,
     /// The last encoder verge reading (deg), whose change the next reading's frame predicts.
     encoder_deg: Option<f64>,
+    /// The still model's squared innovations over the last still frames, each normalised by
+    /// its variance under the estimator's own σ.
+    still_innovations: VecDeque<f64>,
+    /// The factor the estimator's σ is multiplied by (≥ 1).
+    noise_scale: f64,
 }
 
 impl VergeFilter {
@@ -202,7 +234,15 @@ impl VergeFilter {
             state: None,
             fallback: None,
             encoder_deg: None,
+            still_innovations: VecDeque::new(),
+            noise_scale: 1.0,
         }
+    }
+
+    /// The factor the filter has learned to multiply the estimator's σ by (1 until the still
+    /// frames' innovations show the σ too small; module doc).
+    pub fn noise_scale(&self) -> f64 {
+        self.noise_scale
     }
 
     /// Advances to `timestamp_us` and fuses `measurement` if any. Returns `None` while no
@@ -274,7 +314,31 @@ impl VergeFilter {
         }
         let next = update(&predicted, m.verge_deg, r, self.config.likelihood_dof);
         self.state = Some(next);
+        if predicted.mu[STILL] >= 0.5 {
+            self.learn_noise_scale(&predicted.models[STILL], m);
+        }
         Ok(Some(output(&next, status)))
+    }
+
+    /// Adds a still frame's innovation under `still`'s prediction and updates the noise scale.
+    fn learn_noise_scale(&mut self, still: &Gaussian, m: Measurement) {
+        let n = self.config.noise_scale_frames;
+        if n == 0 {
+            return;
+        }
+        let own = self.own_sigma(m);
+        let innovation = m.verge_deg - still.x[0];
+        let window = &mut self.still_innovations;
+        window.push_back(innovation * innovation / (still.p[(0, 0)] + own * own));
+        while window.len() > n {
+            window.pop_front();
+        }
+        if window.len() >= NOISE_SCALE_MIN_FRAMES {
+            let mut sorted: Vec<f64> = window.iter().copied().collect();
+            sorted.sort_by(f64::total_cmp);
+            let median = sorted[sorted.len() / 2];
+            self.noise_scale = (median / CHI2_1_MEDIAN).sqrt().max(1.0);
+        }
     }
 
     /// IMM mixing and the prediction of both models over `dt` seconds: constant verge for the
@@ -340,7 +404,14 @@ impl VergeFilter {
         State { models, mu, t_us }
     }
 
+    /// The σ the filter weighs `m` by: the estimator's own, scaled by what the innovations
+    /// have shown.
     fn measurement_sigma(&self, m: Measurement) -> f64 {
+        self.noise_scale * self.own_sigma(m)
+    }
+
+    /// `m`'s σ as the estimator gives it, within the configured floor.
+    fn own_sigma(&self, m: Measurement) -> f64 {
         if m.sigma_deg.is_finite() {
             m.sigma_deg.max(self.config.min_measurement_sigma_deg)
         } else {
@@ -576,6 +647,62 @@ mod tests {
             }
         }
         assert!(hi - lo < 0.015, "span {}", hi - lo);
+    }
+
+    #[test]
+    fn measurements_that_scatter_beyond_their_sigma_are_weighed_by_their_scatter() {
+        // A still head whose measurements claim 0.01° but scatter ±0.05° (uniform, 0.029° σ),
+        // and after 100 frames three that sit 0.1° off, as a view can hold a real rig's error
+        // for a few frames: weighed by the σ they claim they look like a move.
+        let run = |noise_scale_frames| {
+            let mut f = VergeFilter::new(KalmanConfig {
+                noise_scale_frames,
+                ..KalmanConfig::default()
+            });
+            let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+            for i in 0..160u64 {
+                let noise = 0.05 * ((i * 7919 % 101) as f64 / 50.0 - 1.0);
+                let excursion = if (100..103).contains(&i) { 0.1 } else { 0.0 };
+                let m = Measurement {
+                    verge_deg: 1.6 + noise + excursion,
+                    sigma_deg: 0.01,
+                };
+                let o = f.step(i * 100_000, Some(m)).unwrap().unwrap();
+                if i >= 30 {
+                    lo = lo.min(o.verge_deg);
+                    hi = hi.max(o.verge_deg);
+                }
+            }
+            (f.noise_scale(), hi - lo)
+        };
+        let (scale, span) = run(KalmanConfig::default().noise_scale_frames);
+        let (fixed_scale, fixed_span) = run(0);
+        // The noise's median |z| against the claimed σ alone is 0.025° / 0.01° (a scale of
+        // 2.5 / 0.674 = 3.7); the still model's own spread takes a little of it.
+        assert!((2.5..4.0).contains(&scale), "{scale}");
+        assert_eq!(fixed_scale, 1.0);
+        assert!(span < 0.5 * fixed_span, "span {span} against {fixed_span}");
+    }
+
+    #[test]
+    fn a_right_sigma_is_left_as_it_is() {
+        // Measurements within their σ: the learned scale stays 1 and nothing changes.
+        let run = |noise_scale_frames| {
+            let mut f = VergeFilter::new(KalmanConfig {
+                noise_scale_frames,
+                ..KalmanConfig::default()
+            });
+            let out: Vec<FilterOutput> = (0..100u64)
+                .map(|i| {
+                    let noise = 0.01 * ((i * 7919 % 101) as f64 / 50.0 - 1.0);
+                    f.step(i * 33_333, meas(1.6 + noise)).unwrap().unwrap()
+                })
+                .collect();
+            (f.noise_scale(), out)
+        };
+        let (scale, learned) = run(KalmanConfig::default().noise_scale_frames);
+        assert_eq!(scale, 1.0);
+        assert_eq!(learned, run(0).1);
     }
 
     #[test]
