@@ -657,16 +657,21 @@ mod tests {
         assert!(hi - lo < 0.015, "span {}", hi - lo);
     }
 
+    /// The default filter but for its noise-scale window (0: the estimator's σ as it is).
+    fn with_noise_scale_frames(noise_scale_frames: usize) -> VergeFilter {
+        VergeFilter::new(KalmanConfig {
+            noise_scale_frames,
+            ..KalmanConfig::default()
+        })
+    }
+
     #[test]
     fn measurements_that_scatter_beyond_their_sigma_are_weighed_by_their_scatter() {
         // A still head whose measurements claim 0.01° but scatter ±0.05° (uniform, 0.029° σ),
         // and after 100 frames three that sit 0.1° off, as a view can hold a real rig's error
         // for a few frames: weighed by the σ they claim they look like a move.
         let run = |noise_scale_frames| {
-            let mut f = VergeFilter::new(KalmanConfig {
-                noise_scale_frames,
-                ..KalmanConfig::default()
-            });
+            let mut f = with_noise_scale_frames(noise_scale_frames);
             let (mut lo, mut hi) = (f64::MAX, f64::MIN);
             for i in 0..160u64 {
                 let noise = 0.05 * ((i * 7919 % 101) as f64 / 50.0 - 1.0);
@@ -696,10 +701,7 @@ mod tests {
     fn a_right_sigma_is_left_as_it_is() {
         // Measurements within their σ: the learned scale stays 1 and nothing changes.
         let run = |noise_scale_frames| {
-            let mut f = VergeFilter::new(KalmanConfig {
-                noise_scale_frames,
-                ..KalmanConfig::default()
-            });
+            let mut f = with_noise_scale_frames(noise_scale_frames);
             let out: Vec<FilterOutput> = (0..100u64)
                 .map(|i| {
                     let noise = 0.01 * ((i * 7919 % 101) as f64 / 50.0 - 1.0);
