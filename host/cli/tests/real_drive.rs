@@ -5,6 +5,7 @@
 //! 10 fps (README, "Accuracy on real drives": 0.031°), which it does only because the filter
 //! learns how far off the view puts its measurements (`host/src/kalman.rs`; 0.056° without).
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -36,7 +37,22 @@ fn kitti() -> Option<PathBuf> {
     None
 }
 
-fn stereocal(args: &[&Path]) -> Vec<u8> {
+/// The `--left`, `--right` and `--calib` arguments of the sequence in `dir`, each flag and its
+/// value as one argument (`--left=DIR/left`).
+fn sequence(dir: &Path) -> [OsString; 3] {
+    [
+        ("left", "left"),
+        ("right", "right"),
+        ("calib", "calib.toml"),
+    ]
+    .map(|(flag, name)| {
+        let mut arg = OsString::from(format!("--{flag}="));
+        arg.push(dir.join(name));
+        arg
+    })
+}
+
+fn stereocal(args: &[OsString]) -> Vec<u8> {
     let out = Command::new(BIN)
         .args(args)
         .output()
@@ -54,37 +70,28 @@ fn a_held_head_on_a_real_drive_keeps_its_filtered_span() {
     let Some(kitti) = kitti() else { return };
     let tmp = tempfile::tempdir().expect("temp dir");
     let seq = tmp.path().join("fixed");
-    let p = Path::new;
-    stereocal(&[
-        p("inject"),
-        p("--left"),
-        &kitti.join("left"),
-        p("--right"),
-        &kitti.join("right"),
-        p("--calib"),
-        &kitti.join("calib.toml"),
-        p("--motion"),
-        p("fixed"),
-        p("--out"),
-        &seq,
+    let mut inject: Vec<OsString> = vec!["inject".into()];
+    inject.extend(sequence(&kitti));
+    inject.extend([
+        "--motion".into(),
+        "fixed".into(),
+        "--out".into(),
+        seq.clone().into(),
     ]);
-    let summary = stereocal(&[
-        p("run"),
-        p("--left"),
-        &seq.join("left"),
-        p("--right"),
-        &seq.join("right"),
-        p("--calib"),
-        &seq.join("calib.toml"),
-        p("--truth"),
-        &seq.join("truth.csv"),
-        p("--fps"),
-        p(KITTI_FPS),
-        p("--out"),
-        &tmp.path().join("out"),
-        p("--json"),
+    stereocal(&inject);
+    let mut run: Vec<OsString> = vec!["run".into()];
+    run.extend(sequence(&seq));
+    run.extend([
+        "--truth".into(),
+        seq.join("truth.csv").into(),
+        "--fps".into(),
+        KITTI_FPS.into(),
+        "--out".into(),
+        tmp.path().join("out").into(),
+        "--json".into(),
     ]);
-    let summary: serde_json::Value = serde_json::from_slice(&summary).expect("JSON summary");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&stereocal(&run)).expect("JSON summary");
     let count = |key: &str| summary[key].as_u64().unwrap_or_else(|| panic!("{key}"));
     assert_eq!(count("estimated_frames"), count("frames"), "{summary}");
     let span = summary["filtered_span_deg"]
