@@ -217,9 +217,13 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     pub fn drain(&mut self, max: usize, sink: &mut dyn FnMut(SobelRun<'_>)) {
         let n = max.min(self.len);
         let (first, second) = self.queued();
+        let first = first.get(..n).unwrap_or(first);
+        let second = second
+            .get(..n.saturating_sub(first.len()))
+            .unwrap_or_default();
         let mut runs = Runs::new();
-        for &[data, position] in first.iter().chain(second).take(n) {
-            runs.push(data, position, sink);
+        for words in [first, second] {
+            runs.gather(words, None, |_| {}, sink);
         }
         runs.flush(sink);
         self.head = Self::wrap(self.head + n);
@@ -247,11 +251,10 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
     /// deeper octave over what was set aside; with less, a pass over the FIFO per octave.
     pub fn drain_by_octave(&mut self, stash: &mut [[u32; 2]], sink: &mut dyn FnMut(SobelRun<'_>)) {
         let (first, second) = self.queued();
-        let queued = || first.iter().chain(second);
         if stash.len() < self.len {
             // No room to set pixels aside: a pass over the FIFO per octave.
             for octave in 0..MAX_OCTAVES as u32 {
-                runs_of(octave, queued(), sink);
+                runs_of(octave, [first, second], sink);
             }
         } else {
             // Octave 0's pixels (most of them) go out on the one pass over the FIFO; the
@@ -259,18 +262,19 @@ impl<const W: usize, const LINES: usize> SobelFifo<W, LINES> {
             // aside.
             let mut stashed = 0;
             let mut runs = Runs::new();
-            for &[data, position] in queued() {
-                if sdata::OCTAVE.extract(data) == 0 {
-                    runs.push(data, position, sink);
-                } else if let Some(slot) = stash.get_mut(stashed) {
-                    *slot = [data, position];
-                    stashed += 1;
-                }
+            for words in [first, second] {
+                let set_aside = |w| {
+                    if let Some(slot) = stash.get_mut(stashed) {
+                        *slot = w;
+                        stashed += 1;
+                    }
+                };
+                runs.gather(words, Some(0), set_aside, sink);
             }
             runs.flush(sink);
             let stash = stash.get(..stashed).unwrap_or_default();
             for octave in 1..MAX_OCTAVES as u32 {
-                runs_of(octave, stash.iter(), sink);
+                runs_of(octave, [stash, &[]], sink);
             }
         }
         self.clear();
@@ -359,17 +363,11 @@ impl Drop for SobelAppend<'_> {
     }
 }
 
-/// Hands the runs of `octave`'s pixels among `words` to `sink`.
-fn runs_of<'a>(
-    octave: u32,
-    words: impl Iterator<Item = &'a [u32; 2]>,
-    sink: &mut dyn FnMut(SobelRun<'_>),
-) {
+/// Hands `octave`'s pixels among `words` (two slices, in order) to `sink` in runs.
+fn runs_of(octave: u32, words: [&[[u32; 2]]; 2], sink: &mut dyn FnMut(SobelRun<'_>)) {
     let mut runs = Runs::new();
-    for &[data, position] in words {
-        if sdata::OCTAVE.extract(data) == octave {
-            runs.push(data, position, sink);
-        }
+    for words in words {
+        runs.gather(words, Some(octave), |_| {}, sink);
     }
     runs.flush(sink);
 }
@@ -378,10 +376,13 @@ fn runs_of<'a>(
 struct Runs {
     magnitude: [u8; DRAIN_RUN],
     orientation: [u8; DRAIN_RUN],
-    /// The run's data word (its octave), its first position word and its length.
+    /// The run's data word (its octave) and its first position word.
     data: u32,
     start: u32,
+    /// Pixels in the run, and the most it may hold: [`DRAIN_RUN`], or fewer where its row
+    /// ends in the position word's `x` field (whose next value would carry into `y`).
     n: usize,
+    room: usize,
 }
 
 impl Runs {
@@ -392,35 +393,55 @@ impl Runs {
             data: 0,
             start: 0,
             n: 0,
+            room: 0,
         }
     }
 
-    /// Adds the pixel of these words, handing the run to `sink` first when the pixel does
-    /// not continue it (another octave or row, a gap, a full buffer). The position word is
-    /// `y` above `x`, so the next column of the row is the next word, unless `x` would wrap.
+    /// Adds the pixels of `words` (of `octave` only, when given; the others go to `other`),
+    /// handing the run to `sink` whenever a pixel does not continue it (another octave or
+    /// row, a gap, a full buffer). The position word is `y` above `x`, so the next column of
+    /// the row is the next word, unless `x` would wrap: `room` stops the run there. An empty
+    /// run has no room, so its first pixel starts one. The run's state stays in locals over
+    /// the loop: this is the in-process device's per-pixel path.
     #[inline]
-    fn push(&mut self, data: u32, position: u32, sink: &mut dyn FnMut(SobelRun<'_>)) {
-        let continues = self.n > 0
-            && self.n < DRAIN_RUN
-            && sdata::OCTAVE.extract(data) == sdata::OCTAVE.extract(self.data)
-            && spos::X.extract(self.start) as usize + self.n <= spos::X.bits.max_value() as usize
-            && position == self.start.wrapping_add(self.n as u32);
-        if !continues {
-            self.flush(sink);
-            self.data = data;
-            self.start = position;
+    fn gather(
+        &mut self,
+        words: &[[u32; 2]],
+        octave: Option<u32>,
+        mut other: impl FnMut([u32; 2]),
+        sink: &mut dyn FnMut(SobelRun<'_>),
+    ) {
+        let (mut n, mut room) = (self.n, self.room);
+        let mut next = self.start.wrapping_add(n as u32);
+        let mut run_octave = sdata::OCTAVE.extract(self.data);
+        for &[data, position] in words {
+            let pixel_octave = sdata::OCTAVE.extract(data);
+            if octave.is_some_and(|o| o != pixel_octave) {
+                other([data, position]);
+                continue;
+            }
+            if n >= room || position != next || pixel_octave != run_octave {
+                self.n = n;
+                self.flush(sink);
+                (self.data, self.start) = (data, position);
+                (n, next, run_octave) = (0, position, pixel_octave);
+                let to_row_end = spos::X
+                    .bits
+                    .max_value()
+                    .saturating_sub(spos::X.extract(position));
+                room = DRAIN_RUN.min(to_row_end as usize + 1);
+            }
+            if let (Some(m), Some(o)) = (self.magnitude.get_mut(n), self.orientation.get_mut(n)) {
+                *m = sdata::MAGNITUDE.extract(data) as u8;
+                *o = sdata::ORIENTATION.extract(data) as u8;
+            }
+            n += 1;
+            next = next.wrapping_add(1);
         }
-        if let (Some(m), Some(o)) = (
-            self.magnitude.get_mut(self.n),
-            self.orientation.get_mut(self.n),
-        ) {
-            *m = sdata::MAGNITUDE.extract(data) as u8;
-            *o = sdata::ORIENTATION.extract(data) as u8;
-        }
-        self.n += 1;
+        (self.n, self.room) = (n, room);
     }
 
-    /// Hands the run gathered so far to `sink`.
+    /// Hands the run gathered so far to `sink`, and empties it.
     fn flush(&mut self, sink: &mut dyn FnMut(SobelRun<'_>)) {
         if self.n == 0 {
             return;
@@ -433,6 +454,7 @@ impl Runs {
             orientation: self.orientation.get(..self.n).unwrap_or_default(),
         });
         self.n = 0;
+        self.room = 0;
     }
 }
 
