@@ -344,13 +344,14 @@ fn textureless_sequence_gives_no_estimate_rows() {
         lines.next(),
         Some(
             "frame,raw_verge_deg,filtered_verge_deg,filtered_sigma_deg,matches,inliers,status,\
-             pitch_deg,roll_deg,baseline_tilt_deg,packets_lost,keypoints_lost,truth_deg"
+             pitch_deg,roll_deg,baseline_tilt_deg,packets_lost,keypoints_lost,truth_deg,\
+             raw_sigma_deg"
         )
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), FRAMES, "{csv}");
     for (i, row) in rows.iter().enumerate() {
-        assert_eq!(row.len(), 13, "{csv}");
+        assert_eq!(row.len(), 14, "{csv}");
         assert_eq!(row[0], i.to_string(), "{csv}");
         assert_eq!(&row[1..4], ["", "", ""], "angles of frame {i}:\n{csv}");
         assert_eq!(row[6], "no_estimate", "{csv}");
@@ -361,6 +362,7 @@ fn textureless_sequence_gives_no_estimate_rows() {
         );
         assert_eq!(&row[10..12], ["0", "0"], "link losses of frame {i}:\n{csv}");
         assert_eq!(row[12], "", "no truth given, frame {i}:\n{csv}");
+        assert_eq!(row[13], "", "no estimate, no sigma, frame {i}:\n{csv}");
     }
     assert!(f.out().join("verge.png").is_file(), "verge.png written");
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::output::record::FrameRecord;
 
 /// Header of `verge.csv`; part of the CLI contract, never reordered (new columns go last).
-pub const VERGE_HEADER: [&str; 13] = [
+pub const VERGE_HEADER: [&str; 14] = [
     "frame",
     "raw_verge_deg",
     "filtered_verge_deg",
@@ -21,6 +21,7 @@ pub const VERGE_HEADER: [&str; 13] = [
     "packets_lost",
     "keypoints_lost",
     "truth_deg",
+    "raw_sigma_deg",
 ];
 
 /// Header of a ground-truth file.
@@ -88,6 +89,7 @@ pub fn write_verge_csv<W: Write>(out: W, records: &[FrameRecord]) -> Result<(), 
             r.link_loss.map_or(0, |l| l.packets_lost).to_string(),
             r.link_loss.map_or(0, |l| l.keypoints_lost).to_string(),
             angle(r.truth_deg),
+            angle(r.raw_sigma_deg),
         ])?;
     }
     w.flush()?;
@@ -163,7 +165,7 @@ mod tests {
             FrameRecord {
                 frame: 0,
                 raw_verge_deg: Some(1.25),
-                raw_sigma_deg: None,
+                raw_sigma_deg: Some(0.02),
                 filtered_verge_deg: Some(1.2),
                 filtered_sigma_deg: Some(0.01),
                 matches: 40,
@@ -203,7 +205,7 @@ mod tests {
             FrameRecord {
                 frame: 2,
                 raw_verge_deg: Some(1.5),
-                raw_sigma_deg: Some(0.02),
+                raw_sigma_deg: Some(0.03),
                 filtered_verge_deg: Some(1.3),
                 filtered_sigma_deg: Some(0.01),
                 matches: 30,
@@ -226,10 +228,11 @@ mod tests {
         assert_eq!(
             text,
             "frame,raw_verge_deg,filtered_verge_deg,filtered_sigma_deg,matches,inliers,status,\
-             pitch_deg,roll_deg,baseline_tilt_deg,packets_lost,keypoints_lost,truth_deg\n\
-             0,1.250000,1.200000,0.010000,40,38,ok,0.010000,-0.030000,0.000000,0,0,1.300000\n\
-             1,,,,2,0,no_estimate,,,,0,0,\n\
-             2,1.500000,1.300000,0.010000,30,29,salvaged,,,,3,7,\n"
+             pitch_deg,roll_deg,baseline_tilt_deg,packets_lost,keypoints_lost,truth_deg,\
+             raw_sigma_deg\n\
+             0,1.250000,1.200000,0.010000,40,38,ok,0.010000,-0.030000,0.000000,0,0,1.300000,0.020000\n\
+             1,,,,2,0,no_estimate,,,,0,0,,\n\
+             2,1.500000,1.300000,0.010000,30,29,salvaged,,,,3,7,,0.030000\n"
         );
     }
 
