@@ -48,7 +48,7 @@ verge.csv): the median σ of the untouched and of the injected run, and the medi
 |est_i - untouched_i - truth_i| / sqrt(σ_i² + σu_i²), which is 0.674 at the median when the
 differential is no more than the two runs' independent match noise.
 
-With --crop-reference a second table says how much of the differential is the injection's crop
+With --crop-reference a third table says how much of the differential is the injection's crop
 rather than its verge: `stereocal inject` keeps only the window every injected frame fills
 (smaller the larger the yaws), so the injected frames see less of the scene than the untouched
 ones, whatever the verge. For each trajectory the untouched frames are cropped to that window

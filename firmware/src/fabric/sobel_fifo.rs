@@ -379,9 +379,10 @@ struct Runs {
     /// The run's data word (its octave) and its first position word.
     data: u32,
     start: u32,
-    /// Pixels in the run, and the most it may hold: [`DRAIN_RUN`], or fewer where its row
-    /// ends in the position word's `x` field (whose next value would carry into `y`).
+    /// Pixels in the run.
     n: usize,
+    /// The most pixels the run may hold: [`DRAIN_RUN`], or fewer where its row ends in the
+    /// position word's `x` field (whose next value would carry into `y`); 0 while empty.
     room: usize,
 }
 
