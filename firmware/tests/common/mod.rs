@@ -62,6 +62,14 @@ pub fn noise_image(w: usize, h: usize, seed: u64) -> Vec<u8> {
     (0..w * h).map(|_| rng.random::<u8>()).collect()
 }
 
+/// Says that a check is skipped, straight to stderr: the test harness captures `eprintln!`,
+/// and a skip must be seen in a plain `cargo test` run.
+fn loud_skip(what: &str) {
+    use std::io::Write;
+    // A closed stderr has nobody to tell.
+    let _ = writeln!(std::io::stderr(), "\n*** SKIPPED {what} ***\n");
+}
+
 /// The real test image as 8-bit grey, or `None` (with a loud message) when the data set is
 /// absent outside CI. Under `CI=true` its absence is a failure.
 pub fn real_image() -> Option<(Vec<u8>, usize, usize)> {
@@ -80,7 +88,7 @@ pub fn real_image() -> Option<(Vec<u8>, usize, usize)> {
                 std::env::var("CI").as_deref() != Ok("true"),
                 "real image missing under CI=true: {path}"
             );
-            eprintln!("\n!!! SKIPPING real-image check: {path} not found !!!\n");
+            loud_skip(&format!("real-image check: {path} not found"));
             None
         }
     }
@@ -98,7 +106,7 @@ pub fn kitti_image() -> Option<(Vec<u8>, usize, usize)> {
             std::env::var("CI").as_deref() != Ok("true"),
             "KITTI frame missing under CI=true: {path}"
         );
-        eprintln!("\n!!! SKIPPING KITTI-frame check: {path} not found !!!\n");
+        loud_skip(&format!("KITTI-frame check: {path} not found"));
         return None;
     }
     let img = image::open(path).expect("KITTI frame decodes").into_luma8();

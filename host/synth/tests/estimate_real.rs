@@ -14,6 +14,7 @@
 //! when absent, and fails instead under `CI=true`. Run in release: `cargo test --release -p stereocal-synth --test
 //! estimate_real -- --nocapture`.
 
+use std::io::Write;
 use std::path::PathBuf;
 
 use image::GrayImage;
@@ -43,8 +44,10 @@ fn data_root() -> Option<PathBuf> {
             root.display()
         );
     }
-    eprintln!(
-        "SKIPPED: real data not found at {} — set STEREOCAL_REAL_DATA",
+    // Straight to stderr: the test harness captures `eprintln!`, and a skip must be seen.
+    let _ = writeln!(
+        std::io::stderr(),
+        "\n*** SKIPPED: real data not found at {} — set STEREOCAL_REAL_DATA ***\n",
         root.display()
     );
     None
