@@ -232,8 +232,9 @@ def run_sift(seq_left, seq_right, calib_path):
     return out
 
 
-def sh(args):
-    p = subprocess.run(args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def sh(args, cwd=ROOT, env=None):
+    """`args`' stdout; a failure ends the script with the command and its stderr."""
+    p = subprocess.run(args, cwd=cwd, env=env, capture_output=True, text=True)
     if p.returncode != 0:
         raise SystemExit(f"command failed ({p.returncode}): {' '.join(args)}\n{p.stderr}")
     return p.stdout
@@ -308,6 +309,11 @@ def noise(est, untouched, truth):
     }
 
 
+def real_data():
+    """The shared real data sets: $STEREOCAL_REAL_DATA, else ../shared/data/real."""
+    return os.environ.get("STEREOCAL_REAL_DATA", os.path.join(ROOT, "..", "shared", "data", "real"))
+
+
 def rectified_sequences(data):
     """(name, dir) of every folder `stereocal run` reads as is; prints why others are left out."""
     found = []
@@ -379,7 +385,7 @@ def main():
                     help="also run the untouched frames cropped to each trajectory's window")
     args = ap.parse_args(argv)
 
-    data = os.environ.get("STEREOCAL_REAL_DATA", os.path.join(ROOT, "..", "shared", "data", "real"))
+    data = real_data()
     if not os.path.isdir(data):
         raise SystemExit(f"no real data at {data} (set STEREOCAL_REAL_DATA)")
     print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)

@@ -25,11 +25,15 @@ Usage: bench/sensitivity.py [--filter] [FILE:OLD=>NEW ...]
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The drive script's command runner and data location (its module level is the standard
+# library alone; its venv is for its own comparison with OpenCV).
+from drives import ROOT, real_data, sh
+
 KALMAN = "host/src/kalman.rs"
 SUMMARY = "host/src/output/summary.rs"
 
@@ -52,13 +56,6 @@ FILTER = (
     + [(f"SETTLING_FRAMES {v}", SUMMARY, "SETTLING_FRAMES: usize = 8;",
         f"SETTLING_FRAMES: usize = {v};") for v in (4, 16)]
 )
-
-
-def sh(args, cwd=None, env=None):
-    p = subprocess.run(args, cwd=cwd, env=env, capture_output=True, text=True)
-    if p.returncode != 0:
-        raise SystemExit(f"command failed ({p.returncode}): {' '.join(args)}\n{p.stderr}")
-    return p.stdout
 
 
 def parse_variant(text):
@@ -107,8 +104,7 @@ def main():
     ap.add_argument("variants", nargs="*", help="FILE:OLD=>NEW")
     args = ap.parse_args()
     variants = (FILTER if args.filter else []) + [parse_variant(v) for v in args.variants]
-    data = os.environ.get("STEREOCAL_REAL_DATA", os.path.join(ROOT, "..", "shared", "data", "real"))
-    kitti = os.path.join(data, "kitti_odometry_drive")
+    kitti = os.path.join(real_data(), "kitti_odometry_drive")
     if not os.path.isdir(kitti):
         raise SystemExit(f"no KITTI drive at {kitti} (set STEREOCAL_REAL_DATA)")
     if sh(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT).strip():
@@ -146,7 +142,7 @@ def main():
     finally:
         subprocess.run(["git", "worktree", "remove", "--force", tree], cwd=ROOT,
                        capture_output=True)
-        subprocess.run(["rm", "-rf", work])
+        shutil.rmtree(work, ignore_errors=True)
 
     f = lambda v: "-" if v is None else f"{v:.4f}°"
     print("Each frame alone (`--misalignment off`); degrees: raw median / filtered median / "
