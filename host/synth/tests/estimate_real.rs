@@ -14,50 +14,15 @@
 //! when absent, and fails instead under `CI=true`. Run in release: `cargo test --release -p stereocal-synth --test
 //! estimate_real -- --nocapture`.
 
-use std::io::Write;
-use std::path::PathBuf;
+mod common;
 
+use common::{data_root, features, grey};
 use image::GrayImage;
 use rayon::prelude::*;
 use stereocal::calib::{Calibration, CameraIntrinsics, Extrinsics};
 use stereocal::estimator::{EstimatorConfig, FrameEstimate, Model, VergeEstimator};
-use stereocal::features::{FeatureFrame, Gradients, Keypoint, SobelPlane};
 use stereocal::kalman::{KalmanConfig, Measurement, VergeFilter};
-use stereocal_firmware::fabric::{run_frame, Config, FastFrontEnd};
 use stereocal_synth::yaw_warp::YawWarp;
-
-fn data_root() -> Option<PathBuf> {
-    let root = std::env::var_os("STEREOCAL_REAL_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../../../shared/data/real"
-            ))
-        });
-    if root.join("eth3d_two_view").is_dir() {
-        return Some(root);
-    }
-    if std::env::var("CI").as_deref() == Ok("true") {
-        panic!(
-            "real data missing at {} (required under CI=true)",
-            root.display()
-        );
-    }
-    // Straight to stderr: the test harness captures `eprintln!`, and a skip must be seen.
-    let _ = writeln!(
-        std::io::stderr(),
-        "\n*** SKIPPED: real data not found at {} — set STEREOCAL_REAL_DATA ***\n",
-        root.display()
-    );
-    None
-}
-
-fn grey(path: &std::path::Path) -> GrayImage {
-    image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .into_luma8()
-}
 
 fn camera(v: &serde_json::Value) -> CameraIntrinsics {
     let f = |k: &str| {
@@ -72,72 +37,6 @@ fn camera(v: &serde_json::Value) -> CameraIntrinsics {
         p2: d(3),
         ..CameraIntrinsics::pinhole(f("fx"), f("fy"), f("cx"), f("cy"))
     }
-}
-
-/// Adaptor: the fabric fast path's extrema and Sobel stream → a host `FeatureFrame` with
-/// full Sobel planes. `keep` filters keypoints by full-resolution position.
-fn features(img: &GrayImage, index: u64, keep: &dyn Fn(f32, f32) -> bool) -> FeatureFrame {
-    let (w, h) = img.dimensions();
-    let config = Config::new(w as u16, h as u16);
-    let mut fe = Box::new(FastFrontEnd::<1280, 640, 320, 160>::new());
-    let mut points = Vec::new();
-    let mut sobel = Vec::new();
-    let overflow = run_frame(
-        &mut *fe,
-        &config,
-        img.as_raw(),
-        &mut |p| points.extend_from_slice(p),
-        &mut |s| sobel.extend(s.pixels()),
-    )
-    .expect("fabric fast path");
-    assert_eq!(
-        overflow.points + overflow.sobel,
-        0,
-        "fabric FIFO overflow {overflow:?}"
-    );
-    let mut planes: Vec<SobelPlane> = Vec::new();
-    for octave in 0..config.octaves {
-        let (pw, ph) = (w.div_ceil(1 << octave), h.div_ceil(1 << octave));
-        let mut mag = vec![0u8; (pw * ph) as usize];
-        let mut ori = vec![0u8; (pw * ph) as usize];
-        for s in sobel.iter().filter(|s| s.octave == octave) {
-            let i = s.y as usize * pw as usize + s.x as usize;
-            if i < mag.len() {
-                mag[i] = s.magnitude;
-                ori[i] = s.orientation;
-            }
-        }
-        planes.push(SobelPlane::new(octave, pw, ph, mag, ori).expect("plane"));
-    }
-    let keypoints: Vec<Keypoint> = points
-        .iter()
-        .map(|p| {
-            let s = (1u32 << p.octave) as f32;
-            Keypoint {
-                x: (p.x as f32 + p.dx.to_num::<f32>()) * s,
-                y: (p.y as f32 + p.dy.to_num::<f32>()) * s,
-                octave: p.octave,
-                scale: p.scale as f32 + p.ds.to_num::<f32>(),
-                dog: p.dog as f32 / 256.0,
-            }
-        })
-        .filter(|k| {
-            keep(k.x, k.y)
-                && k.x >= 0.0
-                && k.y >= 0.0
-                && k.x <= (w - 1) as f32
-                && k.y <= (h - 1) as f32
-        })
-        .collect();
-    FeatureFrame::new(
-        index,
-        index * 33_333,
-        w,
-        h,
-        keypoints,
-        Gradients::Planes(planes),
-    )
-    .expect("frame")
 }
 
 struct Scene {
