@@ -7,13 +7,13 @@
 //! Every file of a rig must read as that rig's TOML, `stereocal run` must estimate the same on
 //! each, and each bad file must be refused with the file, key and line named.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
+use std::path::{Path, PathBuf};
+
+use common::{stereocal, succeeded};
 use stereocal::calib::{Calibration, Extrinsics};
 use stereocal::output::verge_csv::read_truth_csv;
-
-const BIN: &str = env!("CARGO_BIN_EXE_stereocal");
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -88,29 +88,11 @@ fn the_starting_verge_and_misalignments_come_from_r_and_t() {
     assert_eq!(again, load("verged-opencv.yml"));
 }
 
-fn stereocal(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .env_remove("RUST_BACKTRACE")
-        .env_remove("RUST_LIB_BACKTRACE")
-        .args(args)
-        .output()
-        .expect("stereocal runs")
-}
-
-fn ok(out: Output) -> Output {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
 #[test]
 fn run_on_each_format_estimates_what_run_on_the_toml_does() {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("seq");
-    ok(stereocal(&[
+    succeeded(stereocal(&[
         "synth",
         "--scene",
         "road",
@@ -123,7 +105,7 @@ fn run_on_each_format_estimates_what_run_on_the_toml_does() {
     ]));
     let run = |calib: &str| {
         let out = dir.path().join(calib);
-        let summary = ok(stereocal(&[
+        let summary = succeeded(stereocal(&[
             "run",
             "--left",
             seq.join("left").to_str().unwrap(),

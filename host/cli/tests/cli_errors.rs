@@ -10,8 +10,10 @@
 //! Every sequence is a few 160x120 frames (one image is wider, to exceed the fabric), so the
 //! whole file runs in under a second in release.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use image::{GrayImage, Luma};
 use tempfile::TempDir;
@@ -93,9 +95,7 @@ impl Fixture {
     /// output, plus `extra`. Backtraces are off, as for a user: stderr is the message alone,
     /// and no backtrace frame (`lifecycle.rs` holds `cy`) can stand in for the culprit's name.
     fn command(&self, command: &str, extra: &[&str]) -> Output {
-        Command::new(env!("CARGO_BIN_EXE_stereocal"))
-            .env_remove("RUST_BACKTRACE")
-            .env_remove("RUST_LIB_BACKTRACE")
+        common::command()
             .arg(command)
             .arg("--left")
             .arg(self.left())

@@ -10,23 +10,16 @@
 //! every mode keeps the maximum error under 0.05°, except Sobel patches (which leave the
 //! sub-pixel refinement without its octave-0 Sobel plane) under 0.1°.
 
-use std::process::Command;
+mod common;
 
+use common::{stereocal, succeeded};
 use serde_json::Value;
 
 fn eval(extra: &[&str]) -> Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_stereocal"))
-        .args([
-            "eval", "--scene", "road", "--frames", "8", "--seed", "1", "--json",
-        ])
-        .args(extra)
-        .output()
-        .expect("stereocal runs");
-    assert!(
-        out.status.success(),
-        "{extra:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let args = [
+        "eval", "--scene", "road", "--frames", "8", "--seed", "1", "--json",
+    ];
+    let out = succeeded(stereocal(&[&args[..], extra].concat()));
     serde_json::from_slice(&out.stdout).expect("JSON summary")
 }
 

@@ -9,8 +9,10 @@
 //! have been ended by the signal, or the test did not test anything.
 #![cfg(unix)]
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
 
 use image::{GrayImage, Luma};
@@ -72,7 +74,7 @@ fn trial(root: &Path, out: &Path, delay: Duration) -> Trial {
     std::fs::create_dir_all(out).unwrap();
     std::fs::write(out.join("verge.csv"), OLD_CSV).unwrap();
     std::fs::write(out.join("verge.png"), OLD_PNG).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_stereocal"))
+    let mut child = common::command()
         .arg("run")
         .arg("--left")
         .arg(root.join("left"))
@@ -228,7 +230,7 @@ fn ctrl_c_while_inject_writes_leaves_no_staging_and_no_part_of_the_sequence() {
 /// `root`, and checks that it ended by the signal with neither the staging directory nor any
 /// part of `out` left.
 fn interrupt_sequence_writer(root: &Path, out: &Path, args: &[&str]) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_stereocal"))
+    let mut child = common::command()
         .args(args)
         .arg("--out")
         .arg(out)

@@ -5,27 +5,23 @@
 //! on the same images (the same bytes cross the wire), and a head that goes quiet must end in
 //! a timeout that names the link, with the pairs already received written out.
 
+mod common;
+
 use std::io::ErrorKind;
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+use common::{stereocal, succeeded};
 use std::thread;
 use std::time::Duration;
 
 use stereocal::link::{InProcessLink, Link, TimedStream};
 use stereocal_wire::EncodersRepr;
 
-const BIN: &str = env!("CARGO_BIN_EXE_stereocal");
 const FRAMES: usize = 4;
 /// The sequence's frame period at `stereocal run`'s default 30 fps.
 const PERIOD_US: f64 = 1e6 / 30.0;
-
-fn stereocal(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("stereocal runs")
-}
 
 /// Renders the road sequence into `dir` (left/, right/, calib.toml).
 fn synth(dir: &Path) -> (u32, u32) {
@@ -40,11 +36,7 @@ fn synth(dir: &Path) -> (u32, u32) {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeded(out);
     image::open(dir.join("left").join(first_file(&dir.join("left"))))
         .expect("rendered image")
         .to_luma8()
@@ -205,11 +197,7 @@ fn live_equals_run(link_args: &[&str], serve: impl FnOnce(&Path) + Send) {
         ]);
         stereocal(&args)
     });
-    assert!(
-        live.status.success(),
-        "{}",
-        String::from_utf8_lossy(&live.stderr)
-    );
+    let live = succeeded(live);
     let summary: serde_json::Value = serde_json::from_slice(&live.stdout).unwrap();
     assert_eq!(summary["frames"], FRAMES);
     assert_eq!(summary["estimated_frames"], FRAMES);
@@ -224,11 +212,7 @@ fn live_equals_run(link_args: &[&str], serve: impl FnOnce(&Path) + Send) {
         "--out",
         run_out.to_str().unwrap(),
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    succeeded(run);
     let (live, run) = (
         raw_verges(&live_out.join("verge.csv")),
         raw_verges(&run_out.join("verge.csv")),
@@ -377,7 +361,7 @@ fn ctrl_c_ends_the_run_and_writes_what_arrived() {
         });
         let mut args = setup.live_args(&calib, &out_dir);
         args.extend(["--timeout-ms", "3000"]);
-        let child = Command::new(BIN)
+        let child = common::command()
             .args(args)
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::piped())
@@ -392,11 +376,7 @@ fn ctrl_c_ends_the_run_and_writes_what_arrived() {
         assert!(kill.success());
         child.wait_with_output().unwrap()
     });
-    assert!(
-        live.status.success(),
-        "{}",
-        String::from_utf8_lossy(&live.stderr)
-    );
+    succeeded(live);
     assert_eq!(raw_verges(&out_dir.join("verge.csv")).len(), 2);
 }
 
@@ -407,11 +387,7 @@ fn a_head_streaming_before_the_host_connects_starts_the_numbering() {
         ..Quirks::default()
     };
     let (live, _setup) = live_on_a_tcp_head(2, true, quirks, &["--json"]);
-    assert!(
-        live.status.success(),
-        "{}",
-        String::from_utf8_lossy(&live.stderr)
-    );
+    let live = succeeded(live);
     let summary: serde_json::Value = serde_json::from_slice(&live.stdout).unwrap();
     assert_eq!(summary["frames"], 2);
     assert_eq!(summary["estimated_frames"], 2);
@@ -424,11 +400,7 @@ fn a_pair_damaged_on_the_link_is_dropped_and_says_why() {
         ..Quirks::default()
     };
     let (live, setup) = live_on_a_tcp_head(3, true, quirks, &[]);
-    assert!(
-        live.status.success(),
-        "{}",
-        String::from_utf8_lossy(&live.stderr)
-    );
+    let live = succeeded(live);
     let stderr = String::from_utf8_lossy(&live.stderr);
     assert!(
         stderr.contains("frame 1: dropped: ") && stderr.contains("damaged"),
@@ -445,11 +417,7 @@ fn a_pair_that_lost_a_sobel_row_is_salvaged_and_says_what_it_lost() {
     };
     // Salvage is the noisy-link guard's: it makes a lost packet cost little.
     let (live, setup) = live_on_a_tcp_head(3, true, quirks, &["--noisy-link"]);
-    assert!(
-        live.status.success(),
-        "{}",
-        String::from_utf8_lossy(&live.stderr)
-    );
+    succeeded(live);
     assert_eq!(statuses(&setup), ["ok", "salvaged", "ok"]);
     let csv = std::fs::read_to_string(setup.out_dir().join("verge.csv")).unwrap();
     let lost: Vec<&str> = csv.lines().nth(2).unwrap().split(',').skip(10).collect();
@@ -473,11 +441,7 @@ fn a_head_with_encoders_moves_the_filter_as_run_does_with_them() {
         ..Quirks::default()
     };
     let (live, setup) = live_on_a_tcp_head(FRAMES, true, quirks, &[]);
-    assert!(
-        live.status.success(),
-        "{}",
-        String::from_utf8_lossy(&live.stderr)
-    );
+    succeeded(live);
     let (seq, dir) = (&setup.seq, setup.dir.path());
     let encoders = dir.join("encoders.csv");
     let mut text = String::from("frame,left_yaw_deg,right_yaw_deg\n");
@@ -505,11 +469,7 @@ fn a_head_with_encoders_moves_the_filter_as_run_does_with_them() {
         ];
         args.extend_from_slice(extra);
         let done = stereocal(&args);
-        assert!(
-            done.status.success(),
-            "{}",
-            String::from_utf8_lossy(&done.stderr)
-        );
+        succeeded(done);
         filtered_verges(&out.join("verge.csv"))
     };
     let with = run(

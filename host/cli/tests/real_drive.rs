@@ -5,12 +5,13 @@
 //! 10 fps (README, "Accuracy on real drives": 0.031°), which it does only because the filter
 //! learns how far off the view puts its measurements (`host/src/kalman.rs`; 0.056° without).
 
+mod common;
+
 use std::ffi::OsString;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-const BIN: &str = env!("CARGO_BIN_EXE_stereocal");
+use common::{stereocal, succeeded};
 
 /// Issue 21, item 2: the filtered span of a head that holds its verge.
 const SPAN_LIMIT_DEG: f64 = 0.05;
@@ -55,19 +56,6 @@ fn sequence(dir: &Path) -> [OsString; 3] {
     })
 }
 
-fn stereocal(args: &[OsString]) -> Vec<u8> {
-    let out = Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("stereocal runs");
-    assert!(
-        out.status.success(),
-        "stereocal {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
-
 #[test]
 fn a_held_head_on_a_real_drive_keeps_its_filtered_span() {
     let Some(kitti) = kitti() else { return };
@@ -81,7 +69,7 @@ fn a_held_head_on_a_real_drive_keeps_its_filtered_span() {
         "--out".into(),
         seq.clone().into(),
     ]);
-    stereocal(&inject);
+    succeeded(stereocal(&inject));
     let mut run: Vec<OsString> = vec!["run".into()];
     run.extend(sequence(&seq));
     run.extend([
@@ -94,7 +82,7 @@ fn a_held_head_on_a_real_drive_keeps_its_filtered_span() {
         "--json".into(),
     ]);
     let summary: serde_json::Value =
-        serde_json::from_slice(&stereocal(&run)).expect("JSON summary");
+        serde_json::from_slice(&succeeded(stereocal(&run)).stdout).expect("JSON summary");
     let count = |key: &str| summary[key].as_u64().unwrap_or_else(|| panic!("{key}"));
     assert_eq!(count("estimated_frames"), count("frames"), "{summary}");
     let span = summary["filtered_span_deg"]
