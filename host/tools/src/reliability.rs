@@ -148,12 +148,13 @@ pub fn run(
     driver.enable()?;
     let estimator = VergeEstimator::new(workload.calib, EstimatorConfig::default());
     let mut delivered = Vec::new();
+    let mut lefts = HashMap::new();
     for (index, pair) in workload.pairs.iter().enumerate() {
         driver.link_mut().set_active(burst.contains(&index));
         driver
             .link_mut()
             .submit_pair(&pair.left, &pair.right, workload.timestamp_us(index))?;
-        for (frame_id, l, r) in drain_pairs(&mut driver, timeout)? {
+        for (frame_id, l, r) in drain_pairs(&mut driver, &mut lefts, timeout)? {
             let salvaged = l.salvage.is_some() || r.salvage.is_some();
             let result = match estimator.estimate(&l.features, &r.features) {
                 Ok(est) => PairResult::Estimated {
@@ -176,12 +177,16 @@ pub fn run(
 
 /// Takes every frame the driver can assemble from the bytes the device has sent, and pairs
 /// the delivered ones by frame id. The in-process device answers synchronously, so its
-/// receive times out at once when a pair's bytes are used up.
+/// receive times out at once when a pair's bytes are used up. A frame can come out of a
+/// later pair's bytes (one that lost its `FrameEnd` is closed by the next frame's packets),
+/// so the left frames waiting for their partner, `lefts`, outlive the call, as
+/// [`Driver::next_pair`] keeps a frame for the next call; a right frame ends the wait of
+/// every earlier left one, since the device sends each pair's left frame first.
 fn drain_pairs<D: Link + FrameInput>(
     driver: &mut Driver<FaultLink<D>>,
+    lefts: &mut HashMap<u32, ReceivedFrame>,
     timeout: Duration,
 ) -> Result<Vec<(u32, ReceivedFrame, ReceivedFrame)>, ReliabilityError> {
-    let mut lefts: HashMap<u32, ReceivedFrame> = HashMap::new();
     let mut pairs = Vec::new();
     loop {
         let frame = match driver.next_frame(timeout) {
@@ -195,9 +200,11 @@ fn drain_pairs<D: Link + FrameInput>(
                 lefts.insert(frame.frame_id, frame);
             }
             Camera::Right => {
-                if let Some(left) = lefts.remove(&frame.frame_id) {
-                    pairs.push((frame.frame_id, left, frame));
+                let id = frame.frame_id;
+                if let Some(left) = lefts.remove(&id) {
+                    pairs.push((id, left, frame));
                 }
+                lefts.retain(|&waiting, _| waiting > id);
             }
             Camera::Unknown(_) => {}
         }
