@@ -8,6 +8,8 @@ use image::GrayImage;
 use stereocal::features::{FeatureFrame, Gradients, Keypoint, SobelPlane};
 use stereocal_firmware::fabric::{run_frame, Config, FastFrontEnd};
 
+/// The real data: `STEREOCAL_REAL_DATA`, or `../shared/data/real` beside the repository.
+/// `None` with a loud skip when it is absent, a panic instead under `CI=true`.
 pub fn data_root() -> Option<PathBuf> {
     let root = std::env::var_os("STEREOCAL_REAL_DATA")
         .map(PathBuf::from)
@@ -35,6 +37,7 @@ pub fn data_root() -> Option<PathBuf> {
     None
 }
 
+/// The image at `path` in 8-bit grey.
 pub fn grey(path: &std::path::Path) -> GrayImage {
     image::open(path)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
