@@ -20,7 +20,10 @@ const _: () = assert!(DELIMITER == 0);
 /// short packets, such as the firmware's command input. A frame longer than
 /// `N` is reported once as [`FeedResult::OverFull`] and skipped up to its delimiter, so the
 /// next frame decodes normally. Empty frames (`0x00 0x00`) are ignored: a sender may send a
-/// lone `0x00` to flush a receiver's partial frame.
+/// lone `0x00` to flush a receiver's partial frame. With the feature `fec-repair` (the host's
+/// receiver) it also recovers the second of two frames that a lost delimiter joined, when
+/// both fit in `N` (the wire spec, section 2, "Resynchronisation"): the first is lost, as
+/// before, but no longer the second.
 #[derive(Debug, Clone)]
 pub struct Accumulator<const N: usize> {
     /// The COBS bytes of the frame being received.
@@ -36,6 +39,10 @@ pub struct Accumulator<const N: usize> {
     /// Blocks [`fec::repair`](crate::fec::repair) repaired, all frames.
     #[cfg(feature = "fec-repair")]
     fec_blocks_repaired: u64,
+    /// The second of two link frames that a lost delimiter joined, copied out of `buf`
+    /// before `buf` decodes in place, and decoded when the joined frame fails.
+    #[cfg(feature = "fec-repair")]
+    second: Vec<u8, N>,
 }
 
 /// What [`Accumulator::feed`] found. `'de` borrows the accumulator, `'a` the input.
@@ -78,6 +85,8 @@ impl<const N: usize> Accumulator<N> {
             fec: false,
             #[cfg(feature = "fec-repair")]
             fec_blocks_repaired: 0,
+            #[cfg(feature = "fec-repair")]
+            second: Vec::new(),
         }
     }
 
@@ -148,6 +157,16 @@ impl<const N: usize> Accumulator<N> {
             }
             self.delivered = true;
             #[cfg(feature = "fec-repair")]
+            {
+                self.second.clear();
+                if let Some(at) = crate::joined::second_frame_at(&self.buf, self.fec) {
+                    // Both are at most `N` long, so the copy fits.
+                    let _ = self
+                        .second
+                        .extend_from_slice(self.buf.get(at..).unwrap_or(&[]));
+                }
+            }
+            #[cfg(feature = "fec-repair")]
             if self.fec {
                 match crate::fec::repair(&mut self.buf) {
                     Ok(repaired) => {
@@ -155,11 +174,19 @@ impl<const N: usize> Accumulator<N> {
                         self.fec_blocks_repaired += u64::from(repaired.blocks_repaired);
                     }
                     Err(error) => {
+                        if !self.second.is_empty() {
+                            return decode_second(
+                                &mut self.second,
+                                true,
+                                &mut self.fec_blocks_repaired,
+                                rest,
+                            );
+                        }
                         return FeedResult::DecodeError {
                             error,
                             header: None,
                             remaining: rest,
-                        }
+                        };
                     }
                 }
             }
@@ -170,6 +197,13 @@ impl<const N: usize> Accumulator<N> {
                     packet,
                     remaining: rest,
                 },
+                #[cfg(feature = "fec-repair")]
+                Err(_) if !self.second.is_empty() => decode_second(
+                    &mut self.second,
+                    self.fec,
+                    &mut self.fec_blocks_repaired,
+                    rest,
+                ),
                 Err(Rejected { error, header }) => FeedResult::DecodeError {
                     error,
                     header,
@@ -177,6 +211,44 @@ impl<const N: usize> Accumulator<N> {
                 },
             };
         }
+    }
+}
+
+/// Decodes `second`, the second of two joined link frames (protected when `protected`), in
+/// place: the first one is lost, the second no longer with it.
+#[cfg(feature = "fec-repair")]
+fn decode_second<'de, 'a, const N: usize>(
+    second: &'de mut Vec<u8, N>,
+    protected: bool,
+    fec_blocks_repaired: &mut u64,
+    rest: &'a [u8],
+) -> FeedResult<'de, 'a> {
+    if protected {
+        match crate::fec::repair(second) {
+            Ok(repaired) => {
+                second.truncate(repaired.body_len);
+                *fec_blocks_repaired += u64::from(repaired.blocks_repaired);
+            }
+            Err(error) => {
+                return FeedResult::DecodeError {
+                    error,
+                    header: None,
+                    remaining: rest,
+                }
+            }
+        }
+    }
+    match decode_zero_free(second) {
+        Ok((header, packet)) => FeedResult::Success {
+            header,
+            packet,
+            remaining: rest,
+        },
+        Err(Rejected { error, header }) => FeedResult::DecodeError {
+            error,
+            header,
+            remaining: rest,
+        },
     }
 }
 

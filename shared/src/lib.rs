@@ -68,6 +68,8 @@ mod error;
 pub mod fec;
 mod framing;
 mod geometry;
+#[cfg(feature = "fec-repair")]
+mod joined;
 mod le;
 mod packet_repr;
 mod records;

@@ -343,3 +343,102 @@ fn lone_delimiters_are_idle_and_flush_a_partial_frame() {
     assert_eq!(outcome.packets, vec![(5, marker(0xb))]);
     assert_eq!(outcome.errors.len(), 1);
 }
+
+/// `packet` encoded, and protected by the forward error correction when `protected`; with its
+/// delimiter.
+#[cfg(feature = "fec-repair")]
+fn link_frame(seq: u16, packet: &PacketRepr<'_>, protected: bool) -> Vec<u8> {
+    let plain = encoded(seq, packet);
+    if !protected {
+        return plain;
+    }
+    let body = plain.len() - 1;
+    let mut frame = plain;
+    frame.resize(stereocal_wire::fec::protected_len(body) + 1, 0);
+    let total = stereocal_wire::fec::protect(&mut frame, body).expect("protects");
+    frame.truncate(total);
+    frame.push(0);
+    frame
+}
+
+/// What the accumulator makes of `stream`, its frames protected when `protected`.
+#[cfg(feature = "fec-repair")]
+fn run_guarded(stream: &[u8], protected: bool) -> Outcome {
+    let mut acc = Accumulator::<{ stereocal_wire::MAX_PROTECTED_LEN }>::new();
+    acc.set_fec(protected);
+    let mut outcome = Outcome::default();
+    let mut window = stream;
+    loop {
+        window = match acc.feed(window) {
+            FeedResult::Consumed => break,
+            FeedResult::OverFull(rest) => {
+                outcome.overfull += 1;
+                rest
+            }
+            FeedResult::DecodeError {
+                error, remaining, ..
+            } => {
+                outcome.errors.push(error);
+                remaining
+            }
+            FeedResult::Success {
+                header, remaining, ..
+            } => {
+                outcome.packets.push((header.seq, marker(header.seq)));
+                remaining
+            }
+        };
+    }
+    outcome
+}
+
+#[cfg(feature = "fec-repair")]
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// A flip that unmakes the delimiter between two frames joins them: the first packet is
+    /// lost, the second decodes, with or without the forward error correction, whatever the
+    /// packets and the byte the delimiter became, as long as the two fit the receiver's buffer
+    /// together (a longer run of bytes is skipped as over-long).
+    #[test]
+    fn a_lost_delimiter_costs_only_the_frame_before_it(
+        first in packet(),
+        second in packet(),
+        flipped in 1u8..=255,
+        protected in any::<bool>(),
+    ) {
+        let mut joined = link_frame(1, &first.repr(), protected);
+        *joined.last_mut().unwrap() = flipped;
+        let second = link_frame(2, &second.repr(), protected);
+        prop_assume!(joined.len() + second.len() - 1 <= stereocal_wire::MAX_PROTECTED_LEN);
+        let stream = [
+            link_frame(0, &marker(0xa), protected),
+            joined,
+            second,
+            link_frame(3, &marker(0xc), protected),
+        ]
+        .concat();
+        let outcome = run_guarded(&stream, protected);
+        let seqs: Vec<u16> = outcome.packets.iter().map(|p| p.0).collect();
+        prop_assert_eq!(seqs, vec![0, 2, 3], "errors {:?}", outcome.errors);
+        prop_assert_eq!(outcome.errors.len(), 0, "{:?}", outcome.errors);
+    }
+
+    /// A damaged byte that the code repairs, even in the header's length, leaves the frame
+    /// whole: it is not taken for two joined frames.
+    #[test]
+    fn a_repaired_header_is_not_a_joined_frame(
+        packet in packet(),
+        at in 0usize..8,
+        flip in 1u8..=255,
+    ) {
+        let mut damaged = link_frame(1, &packet.repr(), true);
+        let at = at.min(damaged.len() - 2);
+        damaged[at] ^= flip;
+        prop_assume!(damaged[at] != 0);
+        let stream = [damaged, link_frame(2, &marker(0xb), true)].concat();
+        let outcome = run_guarded(&stream, true);
+        let seqs: Vec<u16> = outcome.packets.iter().map(|p| p.0).collect();
+        prop_assert_eq!(seqs, vec![1, 2]);
+    }
+}
