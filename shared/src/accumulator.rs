@@ -165,69 +165,33 @@ impl<const N: usize> Accumulator<N> {
                         .second
                         .extend_from_slice(self.buf.get(at..).unwrap_or(&[]));
                 }
-            }
-            #[cfg(feature = "fec-repair")]
-            if self.fec {
-                match crate::fec::repair(&mut self.buf) {
-                    Ok(repaired) => {
-                        self.buf.truncate(repaired.body_len);
-                        self.fec_blocks_repaired += u64::from(repaired.blocks_repaired);
-                    }
-                    Err(error) => {
-                        if !self.second.is_empty() {
-                            return decode_second(
-                                &mut self.second,
-                                true,
-                                &mut self.fec_blocks_repaired,
-                                rest,
-                            );
-                        }
-                        return FeedResult::DecodeError {
-                            error,
-                            header: None,
-                            remaining: rest,
-                        };
-                    }
+                let repaired = &mut self.fec_blocks_repaired;
+                let result = decode_link_frame(&mut self.buf, self.fec, repaired, rest);
+                if matches!(result, FeedResult::DecodeError { .. }) && !self.second.is_empty() {
+                    return decode_link_frame(&mut self.second, self.fec, repaired, rest);
                 }
+                return result;
             }
-            // Every chunk was cut before a zero, so the frame holds none.
-            return match decode_zero_free(&mut self.buf) {
-                Ok((header, packet)) => FeedResult::Success {
-                    header,
-                    packet,
-                    remaining: rest,
-                },
-                #[cfg(feature = "fec-repair")]
-                Err(_) if !self.second.is_empty() => decode_second(
-                    &mut self.second,
-                    self.fec,
-                    &mut self.fec_blocks_repaired,
-                    rest,
-                ),
-                Err(Rejected { error, header }) => FeedResult::DecodeError {
-                    error,
-                    header,
-                    remaining: rest,
-                },
-            };
+            #[cfg(not(feature = "fec-repair"))]
+            return decode_body(&mut self.buf, rest);
         }
     }
 }
 
-/// Decodes `second`, the second of two joined link frames (protected when `protected`), in
-/// place: the first one is lost, the second no longer with it.
+/// Repairs one link frame's bytes in place when `protected` (counting the blocks repaired in
+/// `repaired`), then decodes them.
 #[cfg(feature = "fec-repair")]
-fn decode_second<'de, 'a, const N: usize>(
-    second: &'de mut Vec<u8, N>,
+fn decode_link_frame<'de, 'a, const N: usize>(
+    frame: &'de mut Vec<u8, N>,
     protected: bool,
-    fec_blocks_repaired: &mut u64,
+    repaired: &mut u64,
     rest: &'a [u8],
 ) -> FeedResult<'de, 'a> {
     if protected {
-        match crate::fec::repair(second) {
-            Ok(repaired) => {
-                second.truncate(repaired.body_len);
-                *fec_blocks_repaired += u64::from(repaired.blocks_repaired);
+        match crate::fec::repair(frame) {
+            Ok(done) => {
+                frame.truncate(done.body_len);
+                *repaired += u64::from(done.blocks_repaired);
             }
             Err(error) => {
                 return FeedResult::DecodeError {
@@ -238,7 +202,13 @@ fn decode_second<'de, 'a, const N: usize>(
             }
         }
     }
-    match decode_zero_free(second) {
+    decode_body(frame, rest)
+}
+
+/// Decodes the COBS bytes of one link frame in place. Every chunk was cut before a zero, so
+/// they hold none.
+fn decode_body<'de, 'a>(body: &'de mut [u8], rest: &'a [u8]) -> FeedResult<'de, 'a> {
+    match decode_zero_free(body) {
         Ok((header, packet)) => FeedResult::Success {
             header,
             packet,
