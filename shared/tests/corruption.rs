@@ -41,7 +41,11 @@ struct Outcome {
 
 /// Feeds `stream` in one go (the tests put `RegisterRead` markers around the damage).
 fn run<const N: usize>(stream: &[u8]) -> Outcome {
-    let mut acc = Accumulator::<N>::new();
+    feed_all(Accumulator::<N>::new(), stream)
+}
+
+/// Feeds `stream` to `acc` in one go.
+fn feed_all<const N: usize>(mut acc: Accumulator<N>, stream: &[u8]) -> Outcome {
     let mut outcome = Outcome::default();
     let mut window = stream;
     loop {
@@ -366,30 +370,7 @@ fn link_frame(seq: u16, packet: &PacketRepr<'_>, protected: bool) -> Vec<u8> {
 fn run_guarded(stream: &[u8], protected: bool) -> Outcome {
     let mut acc = Accumulator::<{ stereocal_wire::MAX_PROTECTED_LEN }>::new();
     acc.set_fec(protected);
-    let mut outcome = Outcome::default();
-    let mut window = stream;
-    loop {
-        window = match acc.feed(window) {
-            FeedResult::Consumed => break,
-            FeedResult::OverFull(rest) => {
-                outcome.overfull += 1;
-                rest
-            }
-            FeedResult::DecodeError {
-                error, remaining, ..
-            } => {
-                outcome.errors.push(error);
-                remaining
-            }
-            FeedResult::Success {
-                header, remaining, ..
-            } => {
-                outcome.packets.push((header.seq, marker(header.seq)));
-                remaining
-            }
-        };
-    }
-    outcome
+    feed_all(acc, stream)
 }
 
 #[cfg(feature = "fec-repair")]
