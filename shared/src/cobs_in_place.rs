@@ -21,7 +21,7 @@ use core::ops::Range;
 const FULL_BLOCK: usize = 254;
 
 /// The code byte of a full block.
-const FULL_CODE: u8 = FULL_BLOCK as u8 + 1;
+pub(crate) const FULL_CODE: u8 = FULL_BLOCK as u8 + 1;
 
 /// COBS-encodes `buf[src..src + len]` into `buf[..]` and returns the encoded length, or
 /// `None` when `src` is 0 or `buf` is too short (shorter than the encoding), which

@@ -8,11 +8,9 @@
 //! The check costs a header's worth of COBS decoding per frame; the walk runs only for a
 //! frame longer than its header allows.
 
+use crate::cobs_in_place::FULL_CODE;
 use crate::fec;
-use crate::packet::header::{field, CRC_LEN, HEADER_LEN};
-
-/// The COBS code that stands for 254 data bytes and no zero after them.
-const FULL_CODE: u8 = 0xFF;
+use crate::packet::header::{Packet, CRC_LEN, HEADER_LEN};
 
 /// Where, in `frame` (the bytes between two delimiters, protected by [`fec`] when `protected`),
 /// a second link frame starts when the first one's header says the first ends earlier.
@@ -25,8 +23,7 @@ pub(crate) fn second_frame_at(frame: &[u8], protected: bool) -> Option<usize> {
     } else {
         Some(frame.len())
     };
-    // COBS adds one code byte, and one more per 254 data bytes without a zero.
-    if body.is_some_and(|body| body <= packet_len + 1 + packet_len / 254) {
+    if body.is_some_and(|body| body <= cobs::max_encoding_length(packet_len)) {
         return None;
     }
     let first_body = encoded_len(frame, packet_len)?;
@@ -42,69 +39,56 @@ pub(crate) fn second_frame_at(frame: &[u8], protected: bool) -> Option<usize> {
 /// The packet length (header, payload and CRC) the header of the COBS-encoded `frame` gives.
 fn packet_len(frame: &[u8]) -> Option<usize> {
     let mut header = [0u8; HEADER_LEN];
+    let decoded = groups(frame).flat_map(|g| g.data.iter().chain(g.zero_after.then_some(&0)));
     let mut filled = 0;
-    walk(frame, |group| {
-        for &byte in group {
-            if let Some(slot) = header.get_mut(filled) {
-                *slot = byte;
-                filled += 1;
-            }
-        }
-        filled >= HEADER_LEN
-    });
-    if filled < HEADER_LEN {
-        return None;
+    for (slot, &byte) in header.iter_mut().zip(decoded) {
+        *slot = byte;
+        filled += 1;
     }
-    let len = header.get(field::PAYLOAD_LEN)?;
-    let payload = u16::from_le_bytes([*len.first()?, *len.get(1)?]);
-    Some(HEADER_LEN + usize::from(payload) + CRC_LEN)
+    let payload = Packet::new_unchecked(&header[..]).payload_len();
+    (filled == HEADER_LEN).then_some(HEADER_LEN + usize::from(payload) + CRC_LEN)
 }
 
 /// The length of the COBS encoding at the start of `frame` that decodes to `packet_len`
 /// bytes, or `None` when the code bytes say otherwise.
 fn encoded_len(frame: &[u8], packet_len: usize) -> Option<usize> {
-    let mut at = 0;
     let mut decoded = 0;
-    loop {
-        let code = *frame.get(at)?;
-        if code == 0 {
-            return None;
-        }
-        decoded += usize::from(code) - 1;
-        at += usize::from(code);
+    for group in groups(frame) {
+        decoded += group.data.len();
         if decoded == packet_len {
-            return Some(at);
+            return Some(group.end);
         }
-        if code != FULL_CODE {
-            // The zero the next code stands for.
-            decoded += 1;
-        }
+        decoded += usize::from(group.zero_after);
         if decoded > packet_len {
             return None;
         }
     }
+    None
 }
 
-/// Hands the decoded bytes of `frame`'s COBS groups, with the zeros between them, to `take`
-/// until it returns `true` or the bytes end.
-fn walk(frame: &[u8], mut take: impl FnMut(&[u8]) -> bool) {
+/// One COBS group of a frame: its data bytes, where it ends, and whether a decoded zero
+/// follows it (its code is not [`FULL_CODE`] and another group comes after it).
+struct Group<'a> {
+    data: &'a [u8],
+    end: usize,
+    zero_after: bool,
+}
+
+/// The COBS groups at the start of `frame`, up to its end or to a code byte that cannot be
+/// one (a zero); the last one cut short where the frame ends.
+fn groups(frame: &[u8]) -> impl Iterator<Item = Group<'_>> {
     let mut at = 0;
-    while let Some(&code) = frame.get(at) {
-        if code == 0 {
-            return;
-        }
+    core::iter::from_fn(move || {
+        let code = *frame.get(at).filter(|&&code| code != 0)?;
         let end = at + usize::from(code);
-        let Some(data) = frame.get(at + 1..end.min(frame.len())) else {
-            return;
-        };
-        if take(data) || end >= frame.len() {
-            return;
-        }
-        if code != FULL_CODE && take(&[0]) {
-            return;
-        }
+        let data = frame.get(at + 1..end.min(frame.len()))?;
         at = end;
-    }
+        Some(Group {
+            data,
+            end,
+            zero_after: code != FULL_CODE && end < frame.len(),
+        })
+    })
 }
 
 #[cfg(test)]

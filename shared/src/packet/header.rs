@@ -16,7 +16,7 @@ use crate::packet::kind::PacketKind;
 use crate::packet::source::Source;
 use crate::Error;
 
-pub(crate) mod field {
+mod field {
     use super::Field;
     pub const VERSION: usize = 0;
     pub const KIND: usize = 1;
