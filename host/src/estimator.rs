@@ -25,6 +25,7 @@ use crate::features::{FeatureFrame, Keypoint, SobelPlane};
 use crate::matching::{match_descriptors, Gate, Match, MatchConfig};
 use crate::ransac::{ransac, RansacConfig};
 use crate::subpixel::{guided_pair, refine_pair, RefinedPair, SubpixelConfig, Warp};
+use crate::window_overlap::sigma_inflation;
 
 /// A matched point pair in full-resolution pixels: (left, right).
 pub type PixelPair = ([f64; 2], [f64; 2]);
@@ -413,7 +414,7 @@ impl VergeEstimator {
             })
             .collect();
         let yaws = self
-            .estimate_weighted(&keypoint_pairs, &vec![1.0; keypoint_pairs.len()])
+            .estimate_weighted(&keypoint_pairs, &vec![1.0; keypoint_pairs.len()], None)
             .ok()
             .map(|e| rounded(e.yaws));
         if let Some(yaws) = yaws {
@@ -455,6 +456,11 @@ impl VergeEstimator {
         near: Option<VergeAngles>,
     ) -> Result<FrameEstimate, EstimateError> {
         let mut pairs = self.point_pairs(left, right, &matches, near);
+        // Refined pairs carry their windows, which the σ accounts for where they overlap.
+        let window_side = match (self.config.subpixel, left.plane(0), right.plane(0)) {
+            (Some(sub), Some(_), Some(_)) => Some((2 * sub.half_window + 1) as f64),
+            _ => None,
+        };
         if let (Some(g), Some(sub), Some(pl), Some(pr)) = (
             self.config.guided,
             self.config.subpixel,
@@ -467,7 +473,7 @@ impl VergeEstimator {
         }
         let weights = match_weights(&pairs, self.config.weight_floor_px);
         let pairs: Vec<PixelPair> = pairs.into_iter().map(|(p, _)| p).collect();
-        let mut est = self.estimate_weighted(&pairs, &weights)?;
+        let mut est = self.estimate_weighted(&pairs, &weights, window_side)?;
         est.matches = matches.len();
         let keypoints = left.keypoints();
         est.keypoints_per_octave = per_octave(keypoints.iter().map(|k| k.octave));
@@ -481,13 +487,17 @@ impl VergeEstimator {
         &self,
         pairs: &[PixelPair],
     ) -> Result<FrameEstimate, EstimateError> {
-        self.estimate_weighted(pairs, &vec![1.0; pairs.len()])
+        self.estimate_weighted(pairs, &vec![1.0; pairs.len()], None)
     }
 
+    /// The estimate from `pairs` weighted by `weights`; `window_side`: the side (pixels) of
+    /// the sub-pixel windows the pairs were refined on, whose overlaps widen the σ
+    /// ([`sigma_inflation`]), or `None` for pairs without windows.
     fn estimate_weighted(
         &self,
         pairs: &[PixelPair],
         weights: &[f64],
+        window_side: Option<f64>,
     ) -> Result<FrameEstimate, EstimateError> {
         let need = self.config.min_matches;
         if pairs.len() < need {
@@ -558,6 +568,7 @@ impl VergeEstimator {
                 .filter_map(|(c, &inlier)| inlier.then_some(*c))
                 .collect(),
         };
+        let mut inliers = cfit.inliers;
         if self.config.model == Model::General {
             // Two starts: the constrained solution (right when the head only verges) and the
             // calibrated head with its fixed misalignments (right when a tilt misleads the
@@ -581,6 +592,17 @@ impl VergeEstimator {
             est.yaws = gfit.pose.yaws();
             est.inliers = gfit.inlier_count();
             est.residual_px = gfit.residual_sigma * focal;
+            inliers = gfit.inliers;
+        }
+        if let Some(side) = window_side {
+            let (points, inlier_weights): (Vec<[f64; 2]>, Vec<f64>) = pairs
+                .iter()
+                .zip(weights)
+                .zip(&inliers)
+                .filter(|(_, &inlier)| inlier)
+                .map(|((pair, w), _)| (pair.0, *w))
+                .unzip();
+            est.sigma_deg *= sigma_inflation(&points, &inlier_weights, side);
         }
         if est.inliers < need {
             return Err(EstimateError::TooFewMatches {

@@ -42,3 +42,4 @@ pub mod output;
 pub mod ransac;
 pub mod session;
 pub mod subpixel;
+pub mod window_overlap;
