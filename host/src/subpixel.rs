@@ -121,13 +121,18 @@ fn vector_at(
     [m * c, m * s]
 }
 
-/// The `span` x `span` block of `p`'s Sobel vectors whose top-left pixel is (`x0`, `y0`) into
-/// `out`, one channel after the other; the block lies inside the plane.
-fn vector_block(p: &SobelPlane, x0: usize, y0: usize, span: usize, out: &mut [f32]) {
+/// The `width` x `height` block of `p`'s Sobel vectors whose top-left pixel is (`x0`, `y0`)
+/// into `out`, one channel after the other; the block lies inside the plane.
+fn vector_block(
+    p: &SobelPlane,
+    [x0, y0]: [usize; 2],
+    [width, height]: [usize; 2],
+    out: &mut [f32],
+) {
     let (m, o, stride) = (p.magnitude(), p.orientation(), p.width() as usize);
     let dirs = directions();
-    let (cx, cy) = out[..CHANNELS * span * span].split_at_mut(span * span);
-    let rows = cx.chunks_exact_mut(span).zip(cy.chunks_exact_mut(span));
+    let (cx, cy) = out[..CHANNELS * width * height].split_at_mut(width * height);
+    let rows = cx.chunks_exact_mut(width).zip(cy.chunks_exact_mut(width));
     for (r, (row_x, row_y)) in rows.enumerate() {
         let at = (y0 + r) * stride + x0;
         for (k, (vx, vy)) in row_x.iter_mut().zip(row_y.iter_mut()).enumerate() {
@@ -137,17 +142,21 @@ fn vector_block(p: &SobelPlane, x0: usize, y0: usize, span: usize, out: &mut [f3
 }
 
 /// Samples the `side` x `side` window of `p`'s Sobel vectors centred on (`x`, `y`) into `out`
-/// (one channel after the other), bilinearly, with `block` for the whole pixels it reads. The
-/// window is a pure translation, so every sample shares one pair of fractional weights: the
-/// bounds are checked once and the loop is four loads and a blend, over four equal-length row
-/// slices so that it compiles to vector code without bounds checks. `None` when the window
-/// (plus its interpolation neighbours) leaves the plane or touches a lost row.
+/// (one channel after the other), bilinearly, with `block` for the vectors of the whole pixels
+/// it reads. The window is a pure translation, so every sample shares one pair of fractional
+/// weights: the bounds are checked once and the loop is four loads and a blend, over four
+/// equal-length row slices so that it compiles to vector code without bounds checks. `None`
+/// when the window (plus its interpolation neighbours) leaves the plane or touches a lost row.
+///
+/// `block_origin` is the top-left pixel whose block `block` holds, if any: the refinement's
+/// later steps move the window by fractions of a pixel, mostly within the same whole pixels,
+/// whose vectors are then not converted again.
 fn sample_translated(
     p: &SobelPlane,
     x: f32,
     y: f32,
     half: i32,
-    block: &mut [f32],
+    (block, block_origin): (&mut [f32], &mut Option<(i32, i32)>),
     out: &mut [f32],
 ) -> Option<()> {
     let (w, h) = (p.width() as i32, p.height() as i32);
@@ -167,7 +176,10 @@ fn sample_translated(
     let (w00, w01) = ((1.0 - fx) * (1.0 - fy), fx * (1.0 - fy));
     let (w10, w11) = ((1.0 - fx) * fy, fx * fy);
     let (side, span) = (side as usize, side as usize + 1);
-    vector_block(p, ix as usize, iy as usize, span, block);
+    if *block_origin != Some((ix, iy)) {
+        vector_block(p, [ix as usize, iy as usize], [span, span], block);
+        *block_origin = Some((ix, iy));
+    }
     let channels = block
         .chunks_exact(span * span)
         .zip(out.chunks_exact_mut(side * side));
@@ -215,11 +227,19 @@ fn sample_warped(
     }
     let cols = (x - reach_x).floor() as i64..(x + reach_x).floor() as i64 + 2;
     let rows = (y - reach_y).floor() as i64..(y + reach_y).floor() as i64 + 2;
-    if !p.window_valid(cols, rows) {
+    if !p.window_valid(cols.clone(), rows.clone()) {
         return None;
     }
-    let (m, o, stride) = (p.magnitude(), p.orientation(), p.width() as usize);
-    let dirs = directions();
+    // The vectors of every pixel the window reaches, converted once: each is a corner of up to
+    // four samples. The checks above keep the block inside the plane.
+    let origin = [cols.start as usize, rows.start as usize];
+    let [bw, bh] = [cols.end - cols.start, rows.end - rows.start].map(|n| n as usize);
+    let mut reached = REACHED.take();
+    if reached.len() < CHANNELS * bw * bh {
+        reached.resize(CHANNELS * bw * bh, 0.0);
+    }
+    vector_block(p, origin, [bw, bh], &mut reached);
+    let (rx, ry) = reached[..CHANNELS * bw * bh].split_at(bw * bh);
     let side = (2 * half + 1) as usize;
     let (out_x, out_y) = out[..CHANNELS * side * side].split_at_mut(side * side);
     let rows = out_x
@@ -229,23 +249,23 @@ fn sample_warped(
         let dy = r as f32 - h;
         let (mut sx, mut sy) = (x - a * h + b * dy, y - c * h + d * dy);
         for (ox, oy) in row_x.iter_mut().zip(row_y.iter_mut()) {
-            let (fx, fy) = (sx.floor(), sy.floor());
-            let at = fy as usize * stride + fx as usize;
-            let (tx, ty) = (sx - fx, sy - fy);
-            let p00 = vector_at(m, o, dirs, at);
-            let p01 = vector_at(m, o, dirs, at + 1);
-            let p10 = vector_at(m, o, dirs, at + stride);
-            let p11 = vector_at(m, o, dirs, at + stride + 1);
-            let blend = |k: usize| {
-                let top = p00[k] + tx * (p01[k] - p00[k]);
-                let bottom = p10[k] + tx * (p11[k] - p10[k]);
+            // Every sample lies within the window's reach (truncation is the floor there,
+            // without a call to `floorf`); the bounds hold a rounding at its edges in the block.
+            let bx = (sx as usize).saturating_sub(origin[0]).min(bw - 2);
+            let by = (sy as usize).saturating_sub(origin[1]).min(bh - 2);
+            let (tx, ty) = (sx - (origin[0] + bx) as f32, sy - (origin[1] + by) as f32);
+            let at = by * bw + bx;
+            let blend = |c: &[f32]| {
+                let top = c[at] + tx * (c[at + 1] - c[at]);
+                let bottom = c[at + bw] + tx * (c[at + bw + 1] - c[at + bw]);
                 top + ty * (bottom - top)
             };
-            (*ox, *oy) = (blend(0), blend(1));
+            (*ox, *oy) = (blend(rx), blend(ry));
             sx += a;
             sy += c;
         }
     }
+    REACHED.set(reached);
     Some(())
 }
 
@@ -274,6 +294,9 @@ fn template_row(
 }
 
 thread_local! {
+    /// [`sample_warped`]'s block of the vectors its window reaches, kept per thread between
+    /// calls as [`SCRATCH`] is.
+    static REACHED: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
     /// [`refine_pair`]'s working arrays, kept per thread between calls: a match needs seven
     /// window-sized arrays, and taking them from here spares their allocation (or the zeroing
     /// of stack arrays) per match. Every array is written before it is read, so what a previous
@@ -417,9 +440,8 @@ fn refine_in(
     match warp {
         None => vector_block(
             left_plane,
-            (lx - half - 1) as usize,
-            (ly - half - 1) as usize,
-            side + 2,
+            [(lx - half - 1) as usize, (ly - half - 1) as usize],
+            [side + 2, side + 2],
             block,
         ),
         Some(&[a, b, c, d]) => {
@@ -477,8 +499,17 @@ fn refine_in(
     // The right window, zero-mean per channel and scaled to the template's norm, less the
     // template: the residual at `p`, into `residual`. `None` when the window leaves the plane
     // or is flat.
+    // The right plane's block of vectors: none converted yet (the block held the template's).
+    let mut block_origin = None;
     let mut residual_at = |p: [f32; 2], residual: &mut [f32], scratch: &mut [f32]| {
-        sample_translated(right_plane, p[0], p[1], half, block, warped)?;
+        sample_translated(
+            right_plane,
+            p[0],
+            p[1],
+            half,
+            (&mut *block, &mut block_origin),
+            warped,
+        )?;
         let (means, norm) = means_and_norm(warped, scratch);
         if norm <= 0.0 {
             return None;
