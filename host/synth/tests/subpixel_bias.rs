@@ -14,7 +14,7 @@
 //! Pixels that integrate the scene over their area do not give a band-limited image, so the
 //! fabric's gradients of a scene shifted by a fraction of a pixel are not the shifted
 //! gradients; the smoother the scale image the Sobel unit reads, the less of that aliasing
-//! reaches the magnitudes, and the smaller the bias. The test prints the mean and rms error
+//! reaches the gradients, and the smaller the bias. The test prints the mean and rms error
 //! per shift for each of the four scale images and fails when the mean bias on the one a
 //! session configures leaves [`MAX_MEAN_BIAS_PX`]. Run in release: `cargo test --release -p
 //! stereocal-synth --test subpixel_bias -- --nocapture`. Needs `../shared/data/real` (or
