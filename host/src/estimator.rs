@@ -175,7 +175,8 @@ pub enum EstimateError {
 pub struct FrameEstimate {
     /// Verge angle, degrees, toe-in positive.
     pub verge_deg: f64,
-    /// Its 1-σ uncertainty from the refinement's covariance (degrees).
+    /// Its 1-σ uncertainty from the refinement's covariance (degrees), widened by the overlap
+    /// of the matches' sub-pixel windows when they were refined (`window_overlap`).
     pub sigma_deg: f64,
     /// Constrained model: the two camera yaws. General model: `None`.
     pub angles: Option<VergeAngles>,

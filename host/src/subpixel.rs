@@ -6,9 +6,9 @@
 //! snapped to its nearest octave-0 pixel, and the right point is moved to where a window of
 //! the right plane's Sobel vectors (each pixel's magnitude along its orientation code) best
 //! matches the left window (Lucas-Kanade, inverse-compositional, with gain and offset
-//! compensation, since the two cameras' exposures differ; see [`refine_in`] for why vectors). The right
-//! window is not a translated copy of the left one on a verged head: turning a camera by the
-//! verge maps its image by a homography, which stretches and shears a window by several per
+//! compensation, since the two cameras' exposures differ; `refine_in` says why vectors). The
+//! right window is not a translated copy of the left one on a verged head: turning a camera by
+//! the verge maps its image by a homography, which stretches and shears a window by several per
 //! cent at 10-20° (the horizontal scale is 1/cos² of the angle off the axis), and a
 //! translation fitted across such a window moves with the texture's asymmetry. So the left
 //! window (the template) is sampled through the inverse of the homography's local linear map
@@ -298,7 +298,7 @@ thread_local! {
     /// calls as [`SCRATCH`] is.
     static REACHED: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
     /// [`refine_pair`]'s working arrays, kept per thread between calls: a match needs seven
-    /// window-sized arrays, and taking them from here spares their allocation (or the zeroing
+    /// arrays of a window's channels and a block of pixels, and taking them from here spares their allocation (or the zeroing
     /// of stack arrays) per match. Every array is written before it is read, so what a previous
     /// match left in them never matters, and any configured window size gets the same path.
     static SCRATCH: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
