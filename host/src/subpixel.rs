@@ -24,6 +24,7 @@
 
 use std::cell::Cell;
 use std::sync::LazyLock;
+use std::thread::LocalKey;
 
 use crate::features::{SobelPlane, ORIENTATION_STEPS};
 
@@ -234,38 +235,36 @@ fn sample_warped(
     // four samples. The checks above keep the block inside the plane.
     let origin = [cols.start as usize, rows.start as usize];
     let [bw, bh] = [cols.end - cols.start, rows.end - rows.start].map(|n| n as usize);
-    let mut reached = REACHED.take();
-    if reached.len() < CHANNELS * bw * bh {
-        reached.resize(CHANNELS * bw * bh, 0.0);
-    }
-    vector_block(p, origin, [bw, bh], &mut reached);
-    let (rx, ry) = reached[..CHANNELS * bw * bh].split_at(bw * bh);
-    let side = (2 * half + 1) as usize;
-    let (out_x, out_y) = out[..CHANNELS * side * side].split_at_mut(side * side);
-    let rows = out_x
-        .chunks_exact_mut(side)
-        .zip(out_y.chunks_exact_mut(side));
-    for (r, (row_x, row_y)) in rows.enumerate() {
-        let dy = r as f32 - h;
-        let (mut sx, mut sy) = (x - a * h + b * dy, y - c * h + d * dy);
-        for (ox, oy) in row_x.iter_mut().zip(row_y.iter_mut()) {
-            // Every sample lies within the window's reach (truncation is the floor there,
-            // without a call to `floorf`); the bounds hold a rounding at its edges in the block.
-            let bx = (sx as usize).saturating_sub(origin[0]).min(bw - 2);
-            let by = (sy as usize).saturating_sub(origin[1]).min(bh - 2);
-            let (tx, ty) = (sx - (origin[0] + bx) as f32, sy - (origin[1] + by) as f32);
-            let at = by * bw + bx;
-            let blend = |c: &[f32]| {
-                let top = c[at] + tx * (c[at + 1] - c[at]);
-                let bottom = c[at + bw] + tx * (c[at + bw + 1] - c[at + bw]);
-                top + ty * (bottom - top)
-            };
-            (*ox, *oy) = (blend(rx), blend(ry));
-            sx += a;
-            sy += c;
+    with_buffer(&REACHED, CHANNELS * bw * bh, |reached| {
+        vector_block(p, origin, [bw, bh], reached);
+        let (rx, ry) = reached.split_at(bw * bh);
+        let side = (2 * half + 1) as usize;
+        let (out_x, out_y) = out[..CHANNELS * side * side].split_at_mut(side * side);
+        let rows = out_x
+            .chunks_exact_mut(side)
+            .zip(out_y.chunks_exact_mut(side));
+        for (r, (row_x, row_y)) in rows.enumerate() {
+            let dy = r as f32 - h;
+            let (mut sx, mut sy) = (x - a * h + b * dy, y - c * h + d * dy);
+            for (ox, oy) in row_x.iter_mut().zip(row_y.iter_mut()) {
+                // Every sample lies within the window's reach (truncation is the floor there,
+                // without a call to `floorf`); the bounds hold a rounding at its edges in the
+                // block.
+                let bx = (sx as usize).saturating_sub(origin[0]).min(bw - 2);
+                let by = (sy as usize).saturating_sub(origin[1]).min(bh - 2);
+                let (tx, ty) = (sx - (origin[0] + bx) as f32, sy - (origin[1] + by) as f32);
+                let at = by * bw + bx;
+                let blend = |c: &[f32]| {
+                    let top = c[at] + tx * (c[at + 1] - c[at]);
+                    let bottom = c[at + bw] + tx * (c[at + bw + 1] - c[at + bw]);
+                    top + ty * (bottom - top)
+                };
+                (*ox, *oy) = (blend(rx), blend(ry));
+                sx += a;
+                sy += c;
+            }
         }
-    }
-    REACHED.set(reached);
+    });
     Some(())
 }
 
@@ -294,13 +293,14 @@ fn template_row(
 }
 
 thread_local! {
-    /// [`sample_warped`]'s block of the vectors its window reaches, kept per thread between
-    /// calls as [`SCRATCH`] is.
+    /// [`sample_warped`]'s block of the vectors its window reaches, kept per thread as
+    /// [`SCRATCH`] is.
     static REACHED: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
     /// [`refine_pair`]'s working arrays, kept per thread between calls: a match needs seven
-    /// arrays of a window's channels and a block of pixels, and taking them from here spares their allocation (or the zeroing
-    /// of stack arrays) per match. Every array is written before it is read, so what a previous
-    /// match left in them never matters, and any configured window size gets the same path.
+    /// arrays of a window's channels and a block of pixels, and taking them from here spares
+    /// their allocation (or the zeroing of stack arrays) per match. Every array is written
+    /// before it is read, so what a previous match left in them never matters, and any
+    /// configured window size gets the same path.
     static SCRATCH: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
 }
 
@@ -330,25 +330,37 @@ pub fn refine_pair(
     // Inside the plane, so the window side is small enough for any arithmetic below.
     let side = (2 * half + 1) as usize;
     let len = CHANNELS * (SCRATCH_ARRAYS * side * side + (side + 2) * (side + 2));
-    let mut scratch = SCRATCH.take();
-    if scratch.len() < len {
-        scratch.resize(len, 0.0);
-    }
     let [a, b, c, d] = *warp;
     let off = ((a - 1.0).abs() + b.abs() + c.abs() + (d - 1.0).abs()) * half as f32;
     let warp = (off >= WARP_NEGLIGIBLE_PX).then_some(warp);
-    let refined = refine_in(
-        left_plane,
-        right_plane,
-        left,
-        [lx, ly],
-        right,
-        warp,
-        config,
-        &mut scratch[..len],
-    );
-    SCRATCH.set(scratch);
-    refined
+    with_buffer(&SCRATCH, len, |scratch| {
+        refine_in(
+            left_plane,
+            right_plane,
+            left,
+            [lx, ly],
+            right,
+            warp,
+            config,
+            scratch,
+        )
+    })
+}
+
+/// `f` on the first `len` elements of the thread's buffer `cell`, grown to `len` first when
+/// shorter; the buffer stays with the thread for the next call.
+fn with_buffer<R>(
+    cell: &'static LocalKey<Cell<Vec<f32>>>,
+    len: usize,
+    f: impl FnOnce(&mut [f32]) -> R,
+) -> R {
+    let mut buffer = cell.take();
+    if buffer.len() < len {
+        buffer.resize(len, 0.0);
+    }
+    let out = f(&mut buffer[..len]);
+    cell.set(buffer);
+    out
 }
 
 /// Window-sized arrays [`refine_in`] works in, each [`CHANNELS`] windows long (besides the
@@ -496,11 +508,11 @@ fn refine_in(
     if det.is_nan() || det <= 1e-6 * (hxx + hyy).powi(2) || t_norm <= 0.0 {
         return None;
     }
+    // The right plane's block of vectors: none converted yet (the block held the template's).
+    let mut block_origin = None;
     // The right window, zero-mean per channel and scaled to the template's norm, less the
     // template: the residual at `p`, into `residual`. `None` when the window leaves the plane
     // or is flat.
-    // The right plane's block of vectors: none converted yet (the block held the template's).
-    let mut block_origin = None;
     let mut residual_at = |p: [f32; 2], residual: &mut [f32], scratch: &mut [f32]| {
         sample_translated(
             right_plane,

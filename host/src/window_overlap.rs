@@ -5,8 +5,9 @@
 //! larger part of a match's error, README "How much of a match's vertical position is the
 //! pixels' own bias") move both alike. The guided matcher places its matches a few pixels from
 //! the descriptor matches and from each other, so a frame's matches share much of their
-//! windows, and its σ counted them as more evidence than they are: on the rendered road, whose
-//! truth is exact, the median of |error| / σ was 0.90 where an honest σ gives 0.674.
+//! windows, and a σ that takes them as independent counts them as more evidence than they are:
+//! on the rendered road, whose truth is exact, its median |error| / σ is 0.90 where an honest
+//! σ gives 0.674.
 //!
 //! The model: two matches' errors correlate as much as their windows overlap, `(1 - |dx|/s)
 //! (1 - |dy|/s)` for windows of side `s` whose centres are `dx`, `dy` apart. A weighted fit's
