@@ -155,7 +155,7 @@
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_RESET 0x10u
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MIN 1u
 #define STEREOCAL_OUTPUT_MODE_POINTS_PER_BATCH_MAX 128u
-/* [26:16] rw, valid 16..1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels). */
+/* [26:16] rw, valid 16..1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels (at full resolution also those whose sub-pixel refinement reads them), about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels). */
 #define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_SHIFT 16u
 #define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_WIDTH 11u
 #define STEREOCAL_OUTPUT_MODE_ROW_SEGMENT_MASK 0x07FF0000u

@@ -161,7 +161,7 @@ localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_MSB = 15;
 localparam integer SC_OUTPUT_MODE_POINTS_PER_BATCH_WIDTH = 8;
 localparam [31:0] SC_OUTPUT_MODE_POINTS_PER_BATCH_MASK = 32'h0000FF00;
 localparam [7:0] SC_OUTPUT_MODE_POINTS_PER_BATCH_RESET = 8'h10;
-// [26:16] rw, valid 16..1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+// [26:16] rw, valid 16..1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels (at full resolution also those whose sub-pixel refinement reads them), about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
 localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_LSB = 16;
 localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_MSB = 26;
 localparam integer SC_OUTPUT_MODE_ROW_SEGMENT_WIDTH = 11;

@@ -197,7 +197,7 @@ pub trait Registers: RegisterBus {
         self.write_field(&regs::output_mode::POINTS_PER_BATCH, u32::from(value))
     }
 
-    /// OUTPUT_MODE.ROW_SEGMENT `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels, about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
+    /// OUTPUT_MODE.ROW_SEGMENT `[26:16]` rw, reset 1280, valid 16..=1280: Most pixels the stream engine puts in one SobelRows packet: a row wider than this goes out in segments (rows mode). A damaged packet costs the keypoints whose 16x16 window touches its pixels (at full resolution also those whose sub-pixel refinement reads them), about (segment + 16) / width of a lost whole row's; each packet adds about 26 bytes of header, CRC and framing to 2 bytes per pixel. The reset value sends whole rows (the least overhead, for a clean link); 64 suits a noisy one (20 % more bytes, a quarter of a whole row's cost at 320 pixels).
     fn output_mode_row_segment(&mut self) -> u16 {
         self.read_field(&regs::output_mode::ROW_SEGMENT) as u16
     }

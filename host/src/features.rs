@@ -346,22 +346,33 @@ impl FeatureFrame {
         }
     }
 
-    /// Keypoints whose 16×16 gradient window touches a pixel the link lost (0 for an intact
-    /// frame, and in patches mode, where a lost patch is a missing keypoint instead).
-    pub fn keypoints_on_lost_pixels(&self) -> usize {
+    /// Keypoints the link's lost pixels cost the estimate: those whose 16×16 gradient window
+    /// touches a lost pixel of its octave's plane (the descriptor skips it), and, with
+    /// `refinement_reach` (`SubpixelConfig::reach_px`), those with a lost pixel within that
+    /// many of their nearest full-resolution pixel (the sub-pixel refinement of a match there
+    /// fails). A keypoint of a coarser octave keeps its descriptor when a full-resolution row
+    /// goes, but not its refinement. 0 for an intact frame, and in patches mode, where a lost
+    /// patch is a missing keypoint instead.
+    pub fn keypoints_on_lost_pixels(&self, refinement_reach: Option<usize>) -> usize {
         let Gradients::Planes(_) = &self.gradients else {
             return 0;
         };
         let half = (PATCH_SIZE / 2) as i64;
+        let reach = refinement_reach.map(|r| i64::try_from(r).unwrap_or(i64::MAX / 4));
         self.keypoints
             .iter()
             .filter(|kp| {
-                self.plane(kp.octave).is_some_and(|plane| {
+                let descriptor_lost = self.plane(kp.octave).is_some_and(|plane| {
                     let (ox, oy) = kp.octave_position();
                     let (x0, y0) = (ox.round() as i64 - half, oy.round() as i64 - half);
                     let side = PATCH_SIZE as i64;
                     !plane.window_valid(x0..x0 + side, y0..y0 + side)
-                })
+                });
+                let refinement_lost = reach.zip(self.plane(0)).is_some_and(|(r, plane)| {
+                    let (x, y) = (kp.x.round() as i64, kp.y.round() as i64);
+                    !plane.window_valid(x - r..x + r + 1, y - r..y + r + 1)
+                });
+                descriptor_lost || refinement_lost
             })
             .count()
     }

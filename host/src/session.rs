@@ -255,6 +255,7 @@ impl<L: Link> Session<L> {
         let mut driver = Driver::new(device);
         driver.request_fec(config.link.fec);
         driver.set_loss_limit(config.link.loss_limit);
+        driver.set_refinement_reach(config.estimator.subpixel.map(|s| s.reach_px()));
         driver.hello(timeout)?;
         let fabric = config
             .link

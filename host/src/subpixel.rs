@@ -69,6 +69,18 @@ impl Default for SubpixelConfig {
     }
 }
 
+impl SubpixelConfig {
+    /// How far from a keypoint's nearest full-resolution pixel, in rows and in columns, the
+    /// refinement of a match there may read: half the window, the largest shift, a pixel for
+    /// the template's border (its central differences) or the right window's bilinear
+    /// neighbours, and one for the start's rounding to that pixel. A pixel the link lost
+    /// within it costs the match.
+    pub fn reach_px(&self) -> usize {
+        let shift = self.max_shift_px.max(0.0).ceil() as usize;
+        self.half_window.saturating_add(shift).saturating_add(2)
+    }
+}
+
 /// The local linear map from the left window's offsets to the right window's, row-major:
 /// `[dx_r, dy_r] = [[a, b], [c, d]] · [dx_l, dy_l]`. The identity on a parallel head.
 pub type Warp = [f32; 4];

@@ -158,7 +158,7 @@ fn a_lost_sobel_row_costs_only_the_windows_touching_it() {
             rows_lost: vec![1, 0],
             points_lost: Some(0),
             patches_lost: Some(0),
-            keypoints_lost: 1,
+            keypoints_lost: 2,
         })
     );
     let plane = first.features.plane(0).expect("octave 0 plane");
@@ -167,10 +167,19 @@ fn a_lost_sobel_row_costs_only_the_windows_touching_it() {
     let px = pattern(0, 3, 2);
     assert_eq!(plane.get(3, 2), Some((px.magnitude, px.orientation)));
     // Keypoint 0 sits on octave 0 row 6: its 16x16 window covers rows -2..14, row 1 with
-    // them. Keypoint 1's window lies in octave 1, which lost nothing.
+    // them. Keypoint 1's window lies in octave 1, which lost nothing, so its descriptor
+    // stays; but its match is refined on octave 0 around its full-resolution row 9, within
+    // the refinement's 11 px reach of row 1, so it counts as lost too. Without refinement
+    // only keypoint 0 is.
     let mut window = [(0, 0); 256];
     assert_eq!(first.features.window(0, &mut window), 0);
     assert!(first.features.window(1, &mut window) > 0);
+    assert_eq!(first.features.keypoints()[1].y.round(), 9.0);
+    assert_eq!(first.features.keypoints_on_lost_pixels(None), 1);
+    let mut unrefined = salvaging(&wire);
+    unrefined.set_refinement_reach(None);
+    let salvage = delivered(unrefined.next_frame(T).unwrap()).salvage;
+    assert_eq!(salvage.map(|s| s.keypoints_lost), Some(1));
     let set = describe(&first.features, &DescriptorConfig::default());
     assert!((0..set.len()).all(|i| set.keypoint(i) != 0));
     let second = delivered(d.next_frame(T).unwrap());
@@ -213,8 +222,8 @@ fn a_lost_row_segment_costs_only_its_pixels() {
 #[test]
 fn a_frame_that_lost_more_than_the_limit_is_dropped() {
     let mut wire = Wire::new();
-    // One of octave 0's 16 rows: 6 % of its pixels, and keypoint 0's window touches it, half
-    // the frame's two keypoints.
+    // One of octave 0's 16 rows: 6 % of its pixels, keypoint 0's window touches it and
+    // keypoint 1's refinement reach holds it: both of the frame's keypoints.
     for _ in 0..2 {
         wire.frame_losing(&FrameSpec::small(1, Camera::Left), &[row_packet(1)]);
     }
@@ -230,7 +239,7 @@ fn a_frame_that_lost_more_than_the_limit_is_dropped() {
     d.set_loss_limit(0.1);
     assert_eq!(
         damage(d.next_frame(T).unwrap()),
-        Damage::Lost { lost: 1, of: 2 }
+        Damage::Lost { lost: 2, of: 2 }
     );
     assert_eq!(d.stats().damage.lost, 2);
 }

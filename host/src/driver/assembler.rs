@@ -205,6 +205,11 @@ pub(crate) struct FrameAssembler {
     pub stats: LinkStats,
     /// The salvage limit when not [`MAX_LOST_FRACTION`](super::salvage::MAX_LOST_FRACTION).
     pub loss_limit: Option<f64>,
+    /// The estimator's sub-pixel refinement reach
+    /// ([`SubpixelConfig::reach_px`](crate::subpixel::SubpixelConfig::reach_px)), which
+    /// counts a keypoint with a lost pixel within it as lost; `None` when the estimator does
+    /// not refine.
+    pub refinement_reach: Option<usize>,
 }
 
 /// The frame id and camera a frame-body packet carries.
@@ -279,6 +284,15 @@ fn add_body(p: &mut Partial, packet: &PacketRepr<'_>) -> Result<(), ContentError
 }
 
 impl FrameAssembler {
+    /// An assembler that has seen nothing, counting lost pixels within `refinement_reach` of
+    /// a keypoint against it (see [`FrameAssembler::refinement_reach`]).
+    pub fn new(refinement_reach: Option<usize>) -> Self {
+        Self {
+            refinement_reach,
+            ..Self::default()
+        }
+    }
+
     /// The next thing that happened, oldest first.
     pub fn pop_event(&mut self) -> Option<Event> {
         self.events.pop_front()
@@ -643,7 +657,9 @@ impl FrameAssembler {
             return self.close_damaged(p, damage);
         }
         if let Some(s) = &mut salvage {
-            let on_lost_pixels = features.keypoints_on_lost_pixels().min(u32::MAX as usize) as u32;
+            let on_lost_pixels = features
+                .keypoints_on_lost_pixels(self.refinement_reach)
+                .min(u32::MAX as usize) as u32;
             s.keypoints_lost =
                 s.points_lost.unwrap_or(0) + s.patches_lost.unwrap_or(0) + on_lost_pixels;
             // Without its `FrameEnd`, the points that arrived are all the frame is known to have.

@@ -50,6 +50,7 @@ pub use salvage::{Salvage, MAX_LOST_FRACTION};
 pub use stats::LinkStats;
 
 use crate::link::{Link, LinkError};
+use crate::subpixel::SubpixelConfig;
 use assembler::{Event, FrameAssembler};
 
 /// Bytes asked of the link per receive call.
@@ -156,7 +157,7 @@ impl<L: Link> Driver<L> {
             rx_pos: 0,
             rx_len: 0,
             wire_pending: 0,
-            assembler: FrameAssembler::default(),
+            assembler: FrameAssembler::new(Some(SubpixelConfig::default().reach_px())),
             tx: vec![0; MAX_ENCODED_LEN],
             tx_seq: 0,
             frames: VecDeque::new(),
@@ -229,6 +230,14 @@ impl<L: Link> Driver<L> {
     /// intact frames would give.
     pub fn set_loss_limit(&mut self, fraction: f64) {
         self.assembler.loss_limit = Some(fraction.clamp(0.0, 1.0));
+    }
+
+    /// The estimator's sub-pixel refinement reach ([`SubpixelConfig::reach_px`]; `None` when
+    /// it does not refine): a salvaged frame's keypoints with a lost full-resolution pixel
+    /// within it count against the loss limit, since their matches cannot be refined. The
+    /// default refinement's unless set.
+    pub fn set_refinement_reach(&mut self, reach: Option<usize>) {
+        self.assembler.refinement_reach = reach;
     }
 
     /// Whether the device's link frames are taken as protected by forward error correction.

@@ -13,11 +13,16 @@
 //! subset's sigma with the probability of a normal deviate beyond `1 / sqrt(f)`. A pair's two
 //! frames lose their keypoints independently, so at most `2 f` of its matches go; at the limit
 //! `f = 0.05` that is beyond 3.2 sigma, 0.16 % of such pairs, and most salvaged pairs lose far
-//! less. A lost row costs every keypoint whose window touches it (16 rows of its octave), so
-//! the limit counts keypoints, not rows.
+//! less. A lost row costs every keypoint whose window touches it (16 rows of its octave), and
+//! a lost full-resolution row also every keypoint, of any octave, within the sub-pixel
+//! refinement's reach of it (`SubpixelConfig::reach_px`: the match's refinement reads those
+//! rows, and the argument counts the matches the estimate loses); so the limit counts
+//! keypoints, not rows. `stereocal reliability` measures the moves against the argument
+//! (docs/RELIABILITY.md, "How far salvage moves an estimate").
 
 /// The largest fraction of a frame's keypoints a salvaged frame may have lost (points or
-/// patches that did not arrive, and keypoints whose window touches a lost row).
+/// patches that did not arrive, and keypoints whose window touches a lost row or whose
+/// refinement reach holds a lost full-resolution pixel).
 pub const MAX_LOST_FRACTION: f64 = 0.05;
 
 /// What a salvaged camera frame lost on the link.

@@ -25,6 +25,7 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
+use stereocal::output::summary::percentile;
 use stereocal_hdl::regs::output_mode::SobelOutput;
 use stereocal_wire::Camera;
 
@@ -136,6 +137,8 @@ pub fn run(
     let mut driver = Driver::new(link);
     driver.request_fec(protection.fec);
     driver.set_loss_limit(protection.loss_limit);
+    let estimator_config = EstimatorConfig::default();
+    driver.set_refinement_reach(estimator_config.subpixel.map(|s| s.reach_px()));
     driver.hello(timeout)?;
     driver.configure(
         &protection.pack(tuned_fabric_config(
@@ -146,7 +149,7 @@ pub fn run(
         timeout,
     )?;
     driver.enable()?;
-    let estimator = VergeEstimator::new(workload.calib, EstimatorConfig::default());
+    let estimator = VergeEstimator::new(workload.calib, estimator_config);
     let mut delivered = Vec::new();
     let mut lefts = HashMap::new();
     for (index, pair) in workload.pairs.iter().enumerate() {
@@ -274,6 +277,45 @@ pub fn judge(clean: &Run, faulted: &Run, frames: usize, burst: &Range<usize>) ->
         recovery: after.clone().position(is_good),
         bad_after_burst: after.filter(|&f| !is_good(f)).count(),
     }
+}
+
+/// How far salvage moved one salvaged estimate from the clean run's estimate of its pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SalvageMove {
+    /// `|salvaged - clean| / σ`, σ the salvaged estimate's own.
+    pub ratio: f64,
+    /// The move's standard deviation, in the same unit, were the salvaged frame's matches a
+    /// subset of the intact frame's (the argument of `host/src/driver/salvage.rs`): the subset
+    /// estimate is the whole's plus an independent part of variance `σ² - σ_clean²`.
+    pub subset_std: f64,
+}
+
+/// The moves of `faulted`'s salvaged estimates against `clean` (same workload, no faults),
+/// for the pairs both estimated.
+pub fn salvage_moves(clean: &Run, faulted: &Run) -> Vec<SalvageMove> {
+    let expected: HashMap<u32, PairResult> = clean.delivered.iter().copied().collect();
+    faulted
+        .delivered
+        .iter()
+        .filter_map(|(id, result)| match (*result, expected.get(id)) {
+            (
+                PairResult::Estimated {
+                    verge_deg,
+                    sigma_deg,
+                    salvaged: true,
+                },
+                Some(&PairResult::Estimated {
+                    verge_deg: clean_deg,
+                    sigma_deg: clean_sigma,
+                    ..
+                }),
+            ) => Some(SalvageMove {
+                ratio: (verge_deg - clean_deg).abs() / sigma_deg,
+                subset_std: (1.0 - (clean_sigma / sigma_deg).powi(2)).max(0.0).sqrt(),
+            }),
+            _ => None,
+        })
+        .collect()
 }
 
 /// One kind of fault, alone, at `rate`.
@@ -589,7 +631,8 @@ pub fn markdown(sweep: &Sweep, command: &str) -> String {
         md,
         "A fault costs the packet it lands in, not the camera frame. A packet lost costs the \
          points it carried, or the Sobel pixels, and with them every keypoint whose 16x16 \
-         window touches one; a frame that lost more than {:.0} % of its keypoints, or of an \
+         window touches one (at full resolution also every keypoint within {} px of one: \
+         the sub-pixel refinement of its match reads them); a frame that lost more than {:.0} % of its keypoints, or of an \
          octave's Sobel pixels, or its `FrameStart`, is dropped and reported damaged (the \
          limit keeps a salvaged estimate within its own sigma of the intact one, \
          `salvage.rs`; on the clean guard the limit is 0). On the clean guard a pair is \
@@ -597,6 +640,9 @@ pub fn markdown(sweep: &Sweep, command: &str) -> String {
          row and the pair with it. A \
          repeated or overtaken packet is dropped (the overtaken one counts as lost). A stall \
          pauses the link for {} ms, far inside the driver's timeout, and costs time only.\n",
+        EstimatorConfig::default()
+            .subpixel
+            .map_or(0, |s| s.reach_px()),
         MAX_LOST_FRACTION * 100.0,
         pair_bits / 1e6,
         pair_bits * 1e-6,
@@ -653,6 +699,39 @@ pub fn markdown(sweep: &Sweep, command: &str) -> String {
             v.wrong,
             v.bad_after_burst,
             f.peak_buffered,
+        );
+    }
+    let moves: Vec<SalvageMove> = sweep
+        .rows
+        .iter()
+        .flat_map(|row| {
+            let clean = match row.guard {
+                Guard::Clean => &sweep.clean,
+                Guard::Noisy => &sweep.clean_noisy,
+            };
+            salvage_moves(clean, &row.run)
+        })
+        .collect();
+    let ratios: Vec<f64> = moves.iter().map(|m| m.ratio).collect();
+    let subset: Vec<f64> = moves.iter().map(|m| m.subset_std).collect();
+    if let (Some(median), Some(p95), Some(max), Some(subset_median)) = (
+        percentile(&ratios, 0.5),
+        percentile(&ratios, 0.95),
+        percentile(&ratios, 1.0),
+        percentile(&subset, 0.5),
+    ) {
+        let _ = writeln!(
+            md,
+            "\n**How far salvage moves an estimate.** Over the sweep's {} salvaged estimates \
+             whose pair the clean run estimated, |salvaged - clean| in units of the salvaged \
+             estimate's own sigma has median {median:.2}, 95th percentile {p95:.2} and maximum \
+             {max:.2} ({} beyond 1). Were a salvaged frame's matches a subset of the intact \
+             frame's (the argument of the loss limit in `salvage.rs`), the move's standard \
+             deviation in the same unit would be sqrt(1 - sigma_clean² / sigma²), median \
+             {subset_median:.2} over the same estimates, and its median |move| two thirds of \
+             that.",
+            moves.len(),
+            ratios.iter().filter(|&&r| r > 1.0).count(),
         );
     }
     let verdict = if passed(sweep) {

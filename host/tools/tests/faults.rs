@@ -4,7 +4,9 @@
 use std::time::{Duration, Instant};
 
 use stereocal::link::{FaultConfig, FaultLink, Link, LinkError, LinkProtection, ReplayLink};
-use stereocal_tools::reliability::{is_wrong_estimate, judge, run, FaultKind, PairResult};
+use stereocal_tools::reliability::{
+    is_wrong_estimate, judge, run, salvage_moves, FaultKind, PairResult,
+};
 use stereocal_tools::workload::Workload;
 
 const FRAMES: usize = 10;
@@ -106,6 +108,24 @@ fn a_changed_estimate_counts_as_wrong() {
         };
         tampered.delivered[1].1 = salvaged(0.5 * sigma_deg);
         assert_eq!(judge(&clean, &tampered, 3, &(0..0)).wrong, 0);
+        // Its move in units of its own sigma, against a subset's standard deviation: none
+        // when the sigma did not grow, sqrt(3)/2 when it doubled.
+        assert!(salvage_moves(&clean, &clean).is_empty());
+        let moves = salvage_moves(&clean, &tampered);
+        assert_eq!(moves.len(), 1);
+        assert!((moves[0].ratio - 0.5).abs() < 1e-9, "{moves:?}");
+        assert_eq!(moves[0].subset_std, 0.0);
+        tampered.delivered[1].1 = PairResult::Estimated {
+            verge_deg: verge_deg + sigma_deg,
+            sigma_deg: 2.0 * sigma_deg,
+            salvaged: true,
+        };
+        let moves = salvage_moves(&clean, &tampered);
+        assert!((moves[0].ratio - 0.5).abs() < 1e-9, "{moves:?}");
+        assert!(
+            (moves[0].subset_std - 0.75f64.sqrt()).abs() < 1e-9,
+            "{moves:?}"
+        );
         tampered.delivered[1].1 = salvaged(1.5 * sigma_deg);
         assert_eq!(judge(&clean, &tampered, 3, &(0..0)).wrong, 1);
         tampered.delivered[1].1 = PairResult::NoEstimate { salvaged: true };
