@@ -459,7 +459,7 @@ impl VergeEstimator {
         let mut pairs = self.point_pairs(left, right, &matches, near);
         // Refined pairs carry their windows, which the σ accounts for where they overlap.
         let window_side = match (self.config.subpixel, left.plane(0), right.plane(0)) {
-            (Some(sub), Some(_), Some(_)) => Some((2 * sub.half_window + 1) as f64),
+            (Some(sub), Some(_), Some(_)) => Some(sub.window_side() as f64),
             _ => None,
         };
         if let (Some(g), Some(sub), Some(pl), Some(pr)) = (

@@ -70,6 +70,11 @@ impl Default for SubpixelConfig {
 }
 
 impl SubpixelConfig {
+    /// The window's side in pixels, `2·half_window + 1`.
+    pub fn window_side(&self) -> usize {
+        self.half_window.saturating_mul(2).saturating_add(1)
+    }
+
     /// How far from a keypoint's nearest full-resolution pixel, in rows and in columns, the
     /// refinement of a match there may read: half the window, the largest shift, a pixel for
     /// the template's border (its central differences) or the right window's bilinear
@@ -340,7 +345,7 @@ pub fn refine_pair(
         return None;
     }
     // Inside the plane, so the window side is small enough for any arithmetic below.
-    let side = (2 * half + 1) as usize;
+    let side = config.window_side();
     let len = CHANNELS * (SCRATCH_ARRAYS * side * side + (side + 2) * (side + 2));
     let [a, b, c, d] = *warp;
     let off = ((a - 1.0).abs() + b.abs() + c.abs() + (d - 1.0).abs()) * half as f32;
@@ -452,7 +457,7 @@ fn refine_in(
     buffer: &mut [f32],
 ) -> Option<RefinedPair> {
     let half = config.half_window as i32;
-    let side = (2 * half + 1) as usize;
+    let side = config.window_side();
     let n = side * side;
     let (windows, block) = buffer.split_at_mut(SCRATCH_ARRAYS * CHANNELS * n);
     // Template, its two gradients, the warped right window and three arrays of terms.
