@@ -389,7 +389,9 @@ impl VergeEstimator {
     /// degree and its split between the yaws to a degree or two, which is all the second pass
     /// needs: only the matches in the band of the poses within [`REACH_DEG`] of those yaws
     /// (near the image corners much narrower than the whole range's, so it drops the false
-    /// matches the wider band let in), refined through sub-pixel windows warped by them. When
+    /// matches the wider band let in), refined through sub-pixel windows warped as those yaws
+    /// turn the cameras (unrounded: the band's rounding to `YAW_QUANTUM_DEG` serves its
+    /// cache, and would move the warp's verge by up to a whole step). When
     /// that gives no estimate, or the first fit failed, the whole range's matches are refined
     /// as they are.
     pub fn estimate(
@@ -414,11 +416,12 @@ impl VergeEstimator {
                 ([kl.x as f64, kl.y as f64], [kr.x as f64, kr.y as f64])
             })
             .collect();
-        let yaws = self
+        let first = self
             .estimate_weighted(&keypoint_pairs, &vec![1.0; keypoint_pairs.len()], None)
             .ok()
-            .map(|e| rounded(e.yaws));
-        if let Some(yaws) = yaws {
+            .map(|e| e.yaws);
+        if let Some(first) = first {
+            let yaws = rounded(first);
             let near = match self.config.matching.gate {
                 // The near band lies inside the whole range's, so its matches are the whole
                 // range's whose right keypoint lies in it; the ratio test already held against
@@ -440,7 +443,7 @@ impl VergeEstimator {
                 }
                 Gate::Rows(_) | Gate::Off => whole.clone(),
             };
-            if let Ok(est) = self.estimate_from(left, right, near, Some(yaws)) {
+            if let Ok(est) = self.estimate_from(left, right, near, Some(first)) {
                 return Ok(est);
             }
         }

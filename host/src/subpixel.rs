@@ -99,6 +99,20 @@ pub const IDENTITY: Warp = [1.0, 0.0, 0.0, 1.0];
 /// refinement resolves (the u8 magnitudes limit it to a few hundredths).
 const WARP_NEGLIGIBLE_PX: f32 = 0.01;
 
+/// A bound on how far `warp` moves a sample of a window of half side `half` from where the
+/// identity puts it (pixels): the map's deviation from the identity, summed, times `half`.
+fn deformation_px(warp: &Warp, half: i32) -> f32 {
+    let [a, b, c, d] = *warp;
+    ((a - 1.0).abs() + b.abs() + c.abs() + (d - 1.0).abs()) * half as f32
+}
+
+/// A warp that moves the window's edge by this much or more (pixels) is searched through:
+/// a whole-pixel scan of the unwarped window aligns its centre, but not its edges to within
+/// the half pixel of its own step. At a large verge the edges of the image stretch by tens
+/// of per cent between the views, well beyond it; the KITTI drive's 0.6° moves them by at most
+/// about 0.2 px, within it.
+const SCAN_WARP_PX: f32 = 0.5;
+
 /// A refined point pair in octave-0 (full-resolution) pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefinedPair {
@@ -347,9 +361,7 @@ pub fn refine_pair(
     // Inside the plane, so the window side is small enough for any arithmetic below.
     let side = config.window_side();
     let len = CHANNELS * (SCRATCH_ARRAYS * side * side + (side + 2) * (side + 2));
-    let [a, b, c, d] = *warp;
-    let off = ((a - 1.0).abs() + b.abs() + c.abs() + (d - 1.0).abs()) * half as f32;
-    let warp = (off >= WARP_NEGLIGIBLE_PX).then_some(warp);
+    let warp = (deformation_px(warp, half) >= WARP_NEGLIGIBLE_PX).then_some(warp);
     with_buffer(&SCRATCH, len, |scratch| {
         refine_in(
             left_plane,
@@ -713,6 +725,88 @@ fn ncc_scan(
     scores
 }
 
+/// [`ncc_scan`] through `warp`: the correlations of the template the refinement starts from
+/// (the left window's Sobel vectors sampled through the inverse of `warp`, as the right camera
+/// sees them) with the right plane's windows of vectors centred on (`bx + dx`, `by`) for `dx`
+/// in `-search..=search`, in `dx` order; a correlation sums over both channels, each about its
+/// own mean. Positions whose window leaves the plane or touches a lost row, or where either
+/// window is flat, are left out. At a large verge a window near the image's edge is stretched
+/// by tens of per cent between the views, which no whole-pixel shift of the unwarped window
+/// aligns.
+fn ncc_scan_warped(
+    a: &SobelPlane,
+    [ax, ay]: [i32; 2],
+    warp: &Warp,
+    b: &SobelPlane,
+    [bx, by]: [i32; 2],
+    search: i32,
+    half: i32,
+) -> Vec<(i32, f32)> {
+    let mut scores = Vec::new();
+    let [wa, wb, wc, wd] = *warp;
+    let det = wa * wd - wb * wc;
+    if !(det.is_finite() && det.abs() > f32::EPSILON) {
+        return scores;
+    }
+    let inverse = [wd / det, -wb / det, -wc / det, wa / det];
+    let side = (2 * half + 1) as usize;
+    let n = side * side;
+    let mut template = vec![0.0; CHANNELS * n];
+    if sample_warped(a, ax as f32, ay as f32, half, &inverse, &mut template).is_none() {
+        return scores;
+    }
+    let mut squares = vec![0.0; CHANNELS * n];
+    let (t_means, t_norm) = means_and_norm(&template, &mut squares);
+    if t_norm <= 0.0 {
+        return scores;
+    }
+    for (channel, mean) in template.chunks_exact_mut(n).zip(t_means) {
+        channel.iter_mut().for_each(|v| *v -= mean);
+    }
+    // The right windows lie inside the plane for one contiguous range of shifts; their strip
+    // of vectors is converted once.
+    let [bx, by, search, half] = [bx, by, search, half].map(i64::from);
+    let lo = (-search).max(half - bx);
+    let hi = search.min(i64::from(b.width()) - 1 - half - bx);
+    if lo > hi || by - half < 0 || by + half >= i64::from(b.height()) {
+        return scores;
+    }
+    let strip_width = (hi - lo) as usize + side;
+    let mut strip = vec![0.0; CHANNELS * strip_width * side];
+    let origin = [(bx + lo - half) as usize, (by - half) as usize];
+    vector_block(b, origin, [strip_width, side], &mut strip);
+    let mut window = vec![0.0; CHANNELS * n];
+    for (k, dx) in (lo..=hi).enumerate() {
+        let x = bx + dx;
+        if !b.window_valid(x - half..x + half + 1, by - half..by + half + 1) {
+            continue;
+        }
+        for (channel, src) in window
+            .chunks_exact_mut(n)
+            .zip(strip.chunks_exact(strip_width * side))
+        {
+            for (row, src_row) in channel
+                .chunks_exact_mut(side)
+                .zip(src.chunks_exact(strip_width))
+            {
+                row.copy_from_slice(&src_row[k..k + side]);
+            }
+        }
+        let (means, norm) = means_and_norm(&window, &mut squares);
+        if norm <= 0.0 {
+            continue;
+        }
+        let dot: f32 = window
+            .chunks_exact(n)
+            .zip(template.chunks_exact(n))
+            .zip(means)
+            .map(|((w, t), mean)| w.iter().zip(t).map(|(&w, &t)| (w - mean) * t).sum::<f32>())
+            .sum();
+        scores.push((dx as i32, dot / (t_norm * norm)));
+    }
+    scores
+}
+
 /// Vector width (in `u8` pixels) of [`ncc_scan`]'s cross products.
 const LANES: usize = 8;
 
@@ -733,8 +827,9 @@ fn dot_u8(a: &[u8], b: &[u8]) -> u32 {
 
 /// Guided matching for a left point without a descriptor match: searches `±search_px`
 /// horizontally around the predicted right position `guess` (from neighbouring matches) for
-/// the best correlation of the magnitude windows, requires it to beat every other local
-/// maximum clearly, then refines it with [`refine_pair`].
+/// the best correlation of the windows (of magnitudes, or through `warp` of vectors when the
+/// warp moves the window's edge by `SCAN_WARP_PX` or more), requires it to beat every other
+/// local maximum clearly, then refines it with [`refine_pair`].
 pub fn guided_pair(
     left_plane: &SobelPlane,
     right_plane: &SobelPlane,
@@ -748,7 +843,19 @@ pub fn guided_pair(
     let (lx, ly) = (left[0].round() as i32, left[1].round() as i32);
     let gy = (guess[1] + (ly as f32 - left[1])).round() as i32;
     let gx = (guess[0] + (lx as f32 - left[0])).round() as i32;
-    let scores = ncc_scan(left_plane, [lx, ly], right_plane, [gx, gy], search_px, half);
+    let scores = if deformation_px(warp, half) >= SCAN_WARP_PX {
+        ncc_scan_warped(
+            left_plane,
+            [lx, ly],
+            warp,
+            right_plane,
+            [gx, gy],
+            search_px,
+            half,
+        )
+    } else {
+        ncc_scan(left_plane, [lx, ly], right_plane, [gx, gy], search_px, half)
+    };
     let (best_i, &(best_dx, best)) = scores
         .iter()
         .enumerate()
@@ -804,10 +911,16 @@ mod tests {
 
     /// A smooth blob field sampled at a sub-pixel shift.
     fn plane(w: u32, h: u32, sx: f32, sy: f32, gain: f32) -> SobelPlane {
+        mapped(w, h, gain, |x, y| (x - sx, y - sy))
+    }
+
+    /// A `w` x `h` plane of a smooth texture seen at `source(x, y)` from pixel (x, y), scaled
+    /// by `gain`.
+    fn mapped(w: u32, h: u32, gain: f32, source: impl Fn(f32, f32) -> (f32, f32)) -> SobelPlane {
         let mut mag = Vec::new();
         for y in 0..h {
             for x in 0..w {
-                let (xf, yf) = (x as f32 - sx, y as f32 - sy);
+                let (xf, yf) = source(x as f32, y as f32);
                 let v = 100.0
                     + 60.0 * (xf * 0.31).sin() * (yf * 0.23).cos()
                     + 40.0 * ((xf + 2.0 * yf) * 0.17).sin();
@@ -906,6 +1019,47 @@ mod tests {
         .unwrap();
         assert!((got.right[0] - (got.left[0] - 6.4)).abs() < 0.05, "{got:?}");
         assert!((got.right[1] - (got.left[1] + 0.3)).abs() < 0.05, "{got:?}");
+    }
+
+    #[test]
+    fn guided_search_through_a_stretch() {
+        // The right view stretched by 1.3 about column 50 and shifted by -6.4 px, as a large
+        // verge stretches an image's edge: the left point (50, 30) lies at (43.6, 30.3).
+        let (stretch, shift) = (1.3, -6.4);
+        let l = plane(100, 60, 0.0, 0.0, 1.0);
+        let r = mapped(100, 60, 1.0, |x, y| {
+            (50.0 + (x - 50.0 - shift) / stretch, y - 0.3)
+        });
+        let search = |warp: &Warp| {
+            guided_pair(
+                &l,
+                &r,
+                [50.0, 30.0],
+                [47.0, 30.0],
+                8,
+                warp,
+                &SubpixelConfig::default(),
+            )
+        };
+        let got = search(&[stretch, 0.0, 0.0, 1.0]).expect("the warped search matches");
+        assert!((got.right[0] - (50.0 + shift)).abs() < 0.05, "{got:?}");
+        assert!((got.right[1] - 30.3).abs() < 0.05, "{got:?}");
+        // The warped scan peaks at the whole pixel nearest the true shift (-3.4 from the
+        // guess), and higher than the unwarped scan's own peak, which the stretch moves.
+        let peak = |scores: Vec<(i32, f32)>| {
+            scores
+                .into_iter()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap()
+        };
+        let warp = [stretch, 0.0, 0.0, 1.0];
+        let warped = peak(ncc_scan_warped(&l, [50, 30], &warp, &r, [47, 30], 8, 7));
+        let plain = peak(ncc_scan(&l, [50, 30], &r, [47, 30], 8, 7));
+        assert_eq!(warped.0, -3, "{warped:?}");
+        assert!(
+            warped.1 > 0.99 && warped.1 > plain.1,
+            "{warped:?} {plain:?}"
+        );
     }
 
     /// The direct per-position correlation [`ncc_scan`] must reproduce bit for bit.
