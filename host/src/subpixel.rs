@@ -106,6 +106,21 @@ fn deformation_px(warp: &Warp, half: i32) -> f32 {
     ((a - 1.0).abs() + b.abs() + c.abs() + (d - 1.0).abs()) * half as f32
 }
 
+/// The inverse of `warp`; `None` when it is singular (or not finite).
+fn inverse(warp: &Warp) -> Option<Warp> {
+    let [a, b, c, d] = *warp;
+    let det = a * d - b * c;
+    (det.is_finite() && det.abs() > f32::EPSILON).then(|| [d / det, -b / det, -c / det, a / det])
+}
+
+/// The shifts `dx` within `±search` for which the window of half side `half` centred on
+/// column `bx + dx` lies inside `plane`'s columns: one contiguous range, `None` when empty.
+fn shifts_inside(plane: &SobelPlane, bx: i64, search: i64, half: i64) -> Option<(i64, i64)> {
+    let lo = (-search).max(half - bx);
+    let hi = search.min(i64::from(plane.width()) - 1 - half - bx);
+    (lo <= hi).then_some((lo, hi))
+}
+
 /// A warp that moves the window's edge by this much or more (pixels) is searched through:
 /// a whole-pixel scan of the unwarped window aligns its centre, but not its edges to within
 /// the half pixel of its own step. At a large verge the edges of the image stretch by tens
@@ -485,12 +500,8 @@ fn refine_in(
             [side + 2, side + 2],
             block,
         ),
-        Some(&[a, b, c, d]) => {
-            let det = a * d - b * c;
-            if !(det.is_finite() && det.abs() > f32::EPSILON) {
-                return None;
-            }
-            let inverse = [d / det, -b / det, -c / det, a / det];
+        Some(warp) => {
+            let inverse = inverse(warp)?;
             sample_warped(left_plane, lx as f32, ly as f32, half + 1, &inverse, block)?;
         }
     }
@@ -660,9 +671,10 @@ fn ncc_scan(
             && p.window_valid(x - half..x + half + 1, y - half..y + half + 1)
     };
     // The right window lies inside its plane for one contiguous range of shifts.
-    let lo = (-search).max(half - bx);
-    let hi = search.min(i64::from(b.width()) - 1 - half - bx);
-    if lo > hi || !inside(a, ax, ay) || !inside(b, bx + lo, by) {
+    let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
+        return scores;
+    };
+    if !inside(a, ax, ay) || !inside(b, bx + lo, by) {
         return scores;
     }
     let len = (2 * half + 1) as usize;
@@ -743,12 +755,9 @@ fn ncc_scan_warped(
     half: i32,
 ) -> Vec<(i32, f32)> {
     let mut scores = Vec::new();
-    let [wa, wb, wc, wd] = *warp;
-    let det = wa * wd - wb * wc;
-    if !(det.is_finite() && det.abs() > f32::EPSILON) {
+    let Some(inverse) = inverse(warp) else {
         return scores;
-    }
-    let inverse = [wd / det, -wb / det, -wc / det, wa / det];
+    };
     let side = (2 * half + 1) as usize;
     let n = side * side;
     let mut template = vec![0.0; CHANNELS * n];
@@ -766,9 +775,10 @@ fn ncc_scan_warped(
     // The right windows lie inside the plane for one contiguous range of shifts; their strip
     // of vectors is converted once.
     let [bx, by, search, half] = [bx, by, search, half].map(i64::from);
-    let lo = (-search).max(half - bx);
-    let hi = search.min(i64::from(b.width()) - 1 - half - bx);
-    if lo > hi || by - half < 0 || by + half >= i64::from(b.height()) {
+    let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
+        return scores;
+    };
+    if by - half < 0 || by + half >= i64::from(b.height()) {
         return scores;
     }
     let strip_width = (hi - lo) as usize + side;

@@ -453,6 +453,8 @@ pub struct SweepRow {
     pub guard: Guard,
     pub rate: f64,
     pub verdict: Verdict,
+    /// How far salvage moved each salvaged estimate from the clean run of its guard.
+    pub moves: Vec<SalvageMove>,
     pub run: Run,
 }
 
@@ -502,6 +504,7 @@ pub fn sweep(config: SweepConfig, progress: &(dyn Fn() + Sync)) -> Result<Sweep,
                 guard,
                 rate,
                 verdict: judge(reference, &faulted, workload.len(), &burst),
+                moves: salvage_moves(reference, &faulted),
                 run: faulted,
             })
         })
@@ -701,17 +704,7 @@ pub fn markdown(sweep: &Sweep, command: &str) -> String {
             f.peak_buffered,
         );
     }
-    let moves: Vec<SalvageMove> = sweep
-        .rows
-        .iter()
-        .flat_map(|row| {
-            let clean = match row.guard {
-                Guard::Clean => &sweep.clean,
-                Guard::Noisy => &sweep.clean_noisy,
-            };
-            salvage_moves(clean, &row.run)
-        })
-        .collect();
+    let moves: Vec<&SalvageMove> = sweep.rows.iter().flat_map(|row| &row.moves).collect();
     let ratios: Vec<f64> = moves.iter().map(|m| m.ratio).collect();
     let subset: Vec<f64> = moves.iter().map(|m| m.subset_std).collect();
     if let (Some(median), Some(p95), Some(max), Some(subset_median)) = (
