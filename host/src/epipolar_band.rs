@@ -18,7 +18,7 @@
 //! own band.
 
 use nalgebra::{Matrix3, Vector3};
-use rayon::prelude::*;
+use std::sync::OnceLock;
 
 use crate::calib::{Calibration, CameraIntrinsics};
 use crate::essential::constrained::VergeAngles;
@@ -87,14 +87,23 @@ const GRID_STEP_PX: f32 = 16.0;
 
 /// The band of right-image rows, per left-image position, for one calibration, image size and
 /// pose range.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// A node is computed when a point first reads it: the whole range's band serves every
+/// keypoint of every frame and fills in once, but the band near a first fit's pose only sorts
+/// that fit's few hundred matches, which read a fraction of its nodes, and a moving head needs
+/// a new one every few frames.
+#[derive(Debug)]
 pub struct EpipolarBand {
     /// Grid nodes per row and per column.
     nodes: [usize; 2],
     /// Node spacing in pixels, x and y.
     step: [f32; 2],
-    /// Per node, `[lowest, highest]` right row minus the left row (pixels).
-    offsets: Vec<[f32; 2]>,
+    /// Per node, `[lowest, highest]` right row minus the left row (pixels), once computed.
+    offsets: Vec<OnceLock<[f32; 2]>>,
+    /// What a node's band is computed from.
+    calib: Calibration,
+    poses: Vec<Pose>,
+    bounds: ImageBounds,
 }
 
 impl EpipolarBand {
@@ -107,24 +116,27 @@ impl EpipolarBand {
             (width.max(1) - 1) as f32 / (nodes[0] - 1) as f32,
             (height.max(1) - 1) as f32 / (nodes[1] - 1) as f32,
         ];
-        let poses = poses(calib, range);
-        let bounds = ImageBounds::of(&calib.right, width, height);
-        // The nodes are independent: both cores compute them.
-        let offsets = (0..nodes[0] * nodes[1])
-            .into_par_iter()
-            .map(|k| {
-                let (i, j) = (k % nodes[0], k / nodes[0]);
-                let (u, v) = (f64::from(i as f32 * step[0]), f64::from(j as f32 * step[1]));
-                let [lo, hi] = rows(calib, &poses, &bounds, u, v)
-                    .unwrap_or_else(|| far_rows(calib, &poses, u, v));
-                [(lo - v) as f32, (hi - v) as f32]
-            })
-            .collect();
         Self {
             nodes,
             step,
-            offsets,
+            offsets: (0..nodes[0] * nodes[1]).map(|_| OnceLock::new()).collect(),
+            calib: *calib,
+            poses: poses(calib, range),
+            bounds: ImageBounds::of(&calib.right, width, height),
         }
+    }
+
+    /// The offsets of node (`i`, `j`), computed on first use.
+    fn node(&self, i: usize, j: usize) -> [f32; 2] {
+        *self.offsets[j * self.nodes[0] + i].get_or_init(|| {
+            let (u, v) = (
+                f64::from(i as f32 * self.step[0]),
+                f64::from(j as f32 * self.step[1]),
+            );
+            let [lo, hi] = rows(&self.calib, &self.poses, &self.bounds, u, v)
+                .unwrap_or_else(|| far_rows(&self.calib, &self.poses, u, v));
+            [(lo - v) as f32, (hi - v) as f32]
+        })
     }
 
     /// The right rows `[lowest, highest]` where the match of the left point (`x`, `y`) can lie,
@@ -136,8 +148,12 @@ impl EpipolarBand {
         };
         let i = cell(x, self.step[0], self.nodes[0]);
         let j = cell(y, self.step[1], self.nodes[1]);
-        let at = |i: usize, j: usize| self.offsets[j * self.nodes[0] + i];
-        let corners = [at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)];
+        let corners = [
+            self.node(i, j),
+            self.node(i + 1, j),
+            self.node(i, j + 1),
+            self.node(i + 1, j + 1),
+        ];
         let lo = corners.iter().map(|c| c[0]).fold(f32::INFINITY, f32::min);
         let hi = corners
             .iter()
@@ -148,6 +164,7 @@ impl EpipolarBand {
 }
 
 /// One pose: `x_r = rotation · x_l + translation` for camera coordinates (unit baseline).
+#[derive(Debug)]
 struct Pose {
     rotation: Matrix3<f64>,
     translation: Vector3<f64>,
@@ -192,6 +209,7 @@ fn poses(calib: &Calibration, range: &PoseRange) -> Vec<Pose> {
 }
 
 /// The right image's columns in calibrated coordinates (the extent of its border).
+#[derive(Debug)]
 struct ImageBounds {
     x: [f64; 2],
 }
