@@ -46,8 +46,8 @@ pub struct SubpixelConfig {
 impl Default for SubpixelConfig {
     fn default() -> Self {
         Self {
-            // A 15x15 window, the largest whose sums in `ncc_scan` stay exact in `f32`
-            // (225 · 255² < 2^24 < 289 · 255²).
+            // A 15x15 window, the largest whose sums in `SearchLine::magnitudes` stay exact in
+            // `f32` (225 · 255² < 2^24 < 289 · 255²).
             half_window: 7,
             // The inverse-compositional steps converge within a few iterations from a start
             // inside the window; halving or doubling the bound moves the rendered road's raw
@@ -640,184 +640,199 @@ fn refine_in(
     })
 }
 
-/// Normalised cross-correlations of the `(2·half+1)²` window of `a` centred on (`ax`, `ay`)
-/// with the windows of `b` centred on (`bx + dx`, `by`) for `dx` in `-search..=search`, in
-/// `dx` order; positions whose window leaves its plane or where either window is flat are left
-/// out.
-///
-/// Every sum is an integer sum, exact in any order, so each value equals a direct per-position
-/// computation bit for bit (see the tests); what differs is that the left window's sums are
-/// taken once, and the right windows' sums come from per-column sums of the search strip
-/// instead of each position's full window, leaving only the cross products per position, taken
-/// over zero-padded copies of the rows in whole vectors.
-/// Up to the default 15x15 window every sum stays below 2^24 (225 products of at most 255²),
-/// so they convert to `f32` exactly; u32 holds them up to windows of 257x257. Products are
-/// taken in `u16` (255² fits), which the compiler vectorises with plain SSE2.
-fn ncc_scan(
-    a: &SobelPlane,
-    [ax, ay]: [i32; 2],
-    b: &SobelPlane,
-    [bx, by]: [i32; 2],
+/// A guided search: the window of half side `half` of the left plane centred on `left`
+/// against the right plane's windows centred on (`guess[0] + dx`, `guess[1]`) for `dx` in
+/// `-search..=search`, as [`SearchLine::magnitudes`] or [`SearchLine::through`] a warp
+/// correlates them.
+#[derive(Clone, Copy)]
+struct SearchLine<'a> {
+    left_plane: &'a SobelPlane,
+    left: [i32; 2],
+    right_plane: &'a SobelPlane,
+    guess: [i32; 2],
     search: i32,
     half: i32,
-) -> Vec<(i32, f32)> {
-    let mut scores = Vec::new();
-    let [ax, ay, bx, by, search, half] = [ax, ay, bx, by, search, half].map(i64::from);
-    let inside = |p: &SobelPlane, x: i64, y: i64| {
-        x - half >= 0
-            && y - half >= 0
-            && x + half < i64::from(p.width())
-            && y + half < i64::from(p.height())
-            && p.window_valid(x - half..x + half + 1, y - half..y + half + 1)
-    };
-    // The right window lies inside its plane for one contiguous range of shifts.
-    let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
-        return scores;
-    };
-    if !inside(a, ax, ay) || !inside(b, bx + lo, by) {
-        return scores;
-    }
-    let len = (2 * half + 1) as usize;
-    let row_a = |r: usize| {
-        let start = (ay - half) as usize + r;
-        &a.magnitude()[start * a.width() as usize + (ax - half) as usize..][..len]
-    };
-    let strip_len = (hi - lo) as usize + len;
-    let row_b = |r: usize| {
-        let start = (by - half) as usize + r;
-        &b.magnitude()[start * b.width() as usize + (bx + lo - half) as usize..][..strip_len]
-    };
-    let (mut sa, mut saa) = (0u32, 0u32);
-    for r in 0..len {
-        for &x in row_a(r) {
-            sa += u32::from(x);
-            saa += u32::from(u16::from(x) * u16::from(x));
-        }
-    }
-    let (mut col_b, mut col_bb) = (vec![0u32; strip_len], vec![0u32; strip_len]);
-    for r in 0..len {
-        for ((s, ss), &y) in col_b.iter_mut().zip(col_bb.iter_mut()).zip(row_b(r)) {
-            *s += u32::from(y);
-            *ss += u32::from(u16::from(y) * u16::from(y));
-        }
-    }
-    let n = (len * len) as f32;
-    let (sa, saa) = (sa as f32, saa as f32);
-    let va = saa - sa * sa / n;
-    if va <= 0.0 {
-        return scores;
-    }
-    // Copies of the left window's rows and the strip's rows, zero-padded to whole multiples of
-    // `LANES` (the zeros add nothing), so that each row's cross products are whole vectors.
-    let padded = len.div_ceil(LANES) * LANES;
-    let strip_padded = strip_len + padded - len;
-    let mut window_a = vec![0u8; len * padded];
-    let mut strip_b = vec![0u8; len * strip_padded];
-    for (r, (wa, sb)) in window_a
-        .chunks_exact_mut(padded)
-        .zip(strip_b.chunks_exact_mut(strip_padded))
-        .enumerate()
-    {
-        wa[..len].copy_from_slice(row_a(r));
-        sb[..strip_len].copy_from_slice(row_b(r));
-    }
-    for (k, dx) in (lo..=hi).enumerate() {
-        let sb = col_b[k..k + len].iter().sum::<u32>() as f32;
-        let sbb = col_bb[k..k + len].iter().sum::<u32>() as f32;
-        let sab: u32 = window_a
-            .chunks_exact(padded)
-            .zip(strip_b.chunks_exact(strip_padded))
-            .map(|(wa, sb)| dot_u8(wa, &sb[k..k + padded]))
-            .sum();
-        let vb = sbb - sb * sb / n;
-        if vb > 0.0 {
-            scores.push((dx as i32, (sab as f32 - sa * sb / n) / (va * vb).sqrt()));
-        }
-    }
-    scores
 }
 
-/// [`ncc_scan`] through `warp`: the correlations of the template the refinement starts from
-/// (the left window's Sobel vectors sampled through the inverse of `warp`, as the right camera
-/// sees them) with the right plane's windows of vectors centred on (`bx + dx`, `by`) for `dx`
-/// in `-search..=search`, in `dx` order; a correlation sums over both channels, each about its
-/// own mean. Positions whose window leaves the plane or touches a lost row, or where either
-/// window is flat, are left out. At a large verge a window near the image's edge is stretched
-/// by tens of per cent between the views, which no whole-pixel shift of the unwarped window
-/// aligns.
-fn ncc_scan_warped(
-    a: &SobelPlane,
-    [ax, ay]: [i32; 2],
-    warp: &Warp,
-    b: &SobelPlane,
-    [bx, by]: [i32; 2],
-    search: i32,
-    half: i32,
-) -> Vec<(i32, f32)> {
-    let mut scores = Vec::new();
-    let Some(inverse) = inverse(warp) else {
-        return scores;
-    };
-    let side = (2 * half + 1) as usize;
-    let n = side * side;
-    let mut template = vec![0.0; CHANNELS * n];
-    if sample_warped(a, ax as f32, ay as f32, half, &inverse, &mut template).is_none() {
-        return scores;
-    }
-    let mut squares = vec![0.0; CHANNELS * n];
-    let (t_means, t_norm) = means_and_norm(&template, &mut squares);
-    if t_norm <= 0.0 {
-        return scores;
-    }
-    for (channel, mean) in template.chunks_exact_mut(n).zip(t_means) {
-        channel.iter_mut().for_each(|v| *v -= mean);
-    }
-    // The right windows lie inside the plane for one contiguous range of shifts; their strip
-    // of vectors is converted once.
-    let [bx, by, search, half] = [bx, by, search, half].map(i64::from);
-    let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
-        return scores;
-    };
-    if by - half < 0 || by + half >= i64::from(b.height()) {
-        return scores;
-    }
-    let strip_width = (hi - lo) as usize + side;
-    let mut strip = vec![0.0; CHANNELS * strip_width * side];
-    let origin = [(bx + lo - half) as usize, (by - half) as usize];
-    vector_block(b, origin, [strip_width, side], &mut strip);
-    let mut window = vec![0.0; CHANNELS * n];
-    for (k, dx) in (lo..=hi).enumerate() {
-        let x = bx + dx;
-        if !b.window_valid(x - half..x + half + 1, by - half..by + half + 1) {
-            continue;
+impl SearchLine<'_> {
+    /// Normalised cross-correlations of the left window's magnitudes with each right window's,
+    /// in `dx` order; positions whose window leaves its plane or where either window is flat
+    /// are left out.
+    ///
+    /// Every sum is an integer sum, exact in any order, so each value equals a direct
+    /// per-position computation bit for bit (see the tests); what differs is that the left
+    /// window's sums are taken once, and the right windows' sums come from per-column sums of
+    /// the search strip instead of each position's full window, leaving only the cross products
+    /// per position, taken over zero-padded copies of the rows in whole vectors. Up to the
+    /// default 15x15 window every sum stays below 2^24 (225 products of at most 255²), so they
+    /// convert to `f32` exactly; u32 holds them up to windows of 257x257. Products are taken in
+    /// `u16` (255² fits), which the compiler vectorises with plain SSE2.
+    fn magnitudes(&self) -> Vec<(i32, f32)> {
+        let Self {
+            left_plane: a,
+            left: [ax, ay],
+            right_plane: b,
+            guess: [bx, by],
+            search,
+            half,
+        } = *self;
+        let mut scores = Vec::new();
+        let [ax, ay, bx, by, search, half] = [ax, ay, bx, by, search, half].map(i64::from);
+        let inside = |p: &SobelPlane, x: i64, y: i64| {
+            x - half >= 0
+                && y - half >= 0
+                && x + half < i64::from(p.width())
+                && y + half < i64::from(p.height())
+                && p.window_valid(x - half..x + half + 1, y - half..y + half + 1)
+        };
+        // The right window lies inside its plane for one contiguous range of shifts.
+        let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
+            return scores;
+        };
+        if !inside(a, ax, ay) || !inside(b, bx + lo, by) {
+            return scores;
         }
-        for (channel, src) in window
-            .chunks_exact_mut(n)
-            .zip(strip.chunks_exact(strip_width * side))
-        {
-            for (row, src_row) in channel
-                .chunks_exact_mut(side)
-                .zip(src.chunks_exact(strip_width))
-            {
-                row.copy_from_slice(&src_row[k..k + side]);
+        let len = (2 * half + 1) as usize;
+        let row_a = |r: usize| {
+            let start = (ay - half) as usize + r;
+            &a.magnitude()[start * a.width() as usize + (ax - half) as usize..][..len]
+        };
+        let strip_len = (hi - lo) as usize + len;
+        let row_b = |r: usize| {
+            let start = (by - half) as usize + r;
+            &b.magnitude()[start * b.width() as usize + (bx + lo - half) as usize..][..strip_len]
+        };
+        let (mut sa, mut saa) = (0u32, 0u32);
+        for r in 0..len {
+            for &x in row_a(r) {
+                sa += u32::from(x);
+                saa += u32::from(u16::from(x) * u16::from(x));
             }
         }
-        let (means, norm) = means_and_norm(&window, &mut squares);
-        if norm <= 0.0 {
-            continue;
+        let (mut col_b, mut col_bb) = (vec![0u32; strip_len], vec![0u32; strip_len]);
+        for r in 0..len {
+            for ((s, ss), &y) in col_b.iter_mut().zip(col_bb.iter_mut()).zip(row_b(r)) {
+                *s += u32::from(y);
+                *ss += u32::from(u16::from(y) * u16::from(y));
+            }
         }
-        let dot: f32 = window
-            .chunks_exact(n)
-            .zip(template.chunks_exact(n))
-            .zip(means)
-            .map(|((w, t), mean)| w.iter().zip(t).map(|(&w, &t)| (w - mean) * t).sum::<f32>())
-            .sum();
-        scores.push((dx as i32, dot / (t_norm * norm)));
+        let n = (len * len) as f32;
+        let (sa, saa) = (sa as f32, saa as f32);
+        let va = saa - sa * sa / n;
+        if va <= 0.0 {
+            return scores;
+        }
+        // Copies of the left window's rows and the strip's rows, zero-padded to whole multiples of
+        // `LANES` (the zeros add nothing), so that each row's cross products are whole vectors.
+        let padded = len.div_ceil(LANES) * LANES;
+        let strip_padded = strip_len + padded - len;
+        let mut window_a = vec![0u8; len * padded];
+        let mut strip_b = vec![0u8; len * strip_padded];
+        for (r, (wa, sb)) in window_a
+            .chunks_exact_mut(padded)
+            .zip(strip_b.chunks_exact_mut(strip_padded))
+            .enumerate()
+        {
+            wa[..len].copy_from_slice(row_a(r));
+            sb[..strip_len].copy_from_slice(row_b(r));
+        }
+        for (k, dx) in (lo..=hi).enumerate() {
+            let sb = col_b[k..k + len].iter().sum::<u32>() as f32;
+            let sbb = col_bb[k..k + len].iter().sum::<u32>() as f32;
+            let sab: u32 = window_a
+                .chunks_exact(padded)
+                .zip(strip_b.chunks_exact(strip_padded))
+                .map(|(wa, sb)| dot_u8(wa, &sb[k..k + padded]))
+                .sum();
+            let vb = sbb - sb * sb / n;
+            if vb > 0.0 {
+                scores.push((dx as i32, (sab as f32 - sa * sb / n) / (va * vb).sqrt()));
+            }
+        }
+        scores
     }
-    scores
+
+    /// [`SearchLine::magnitudes`] through `warp`: the correlations of the template the
+    /// refinement starts from (the left window's Sobel vectors sampled through the inverse of
+    /// `warp`, as the right camera sees them) with each right window of vectors, in `dx` order;
+    /// a correlation sums over both channels, each about its own mean. Positions whose window
+    /// leaves the plane or touches a lost row, or where either window is flat, are left out. At
+    /// a large verge a window near the image's edge is stretched by tens of per cent between
+    /// the views, which no whole-pixel shift of the unwarped window aligns.
+    fn through(&self, warp: &Warp) -> Vec<(i32, f32)> {
+        let Self {
+            left_plane: a,
+            left: [ax, ay],
+            right_plane: b,
+            guess: [bx, by],
+            search,
+            half,
+        } = *self;
+        let mut scores = Vec::new();
+        let Some(inverse) = inverse(warp) else {
+            return scores;
+        };
+        let side = (2 * half + 1) as usize;
+        let n = side * side;
+        let mut template = vec![0.0; CHANNELS * n];
+        if sample_warped(a, ax as f32, ay as f32, half, &inverse, &mut template).is_none() {
+            return scores;
+        }
+        let mut squares = vec![0.0; CHANNELS * n];
+        let (t_means, t_norm) = means_and_norm(&template, &mut squares);
+        if t_norm <= 0.0 {
+            return scores;
+        }
+        for (channel, mean) in template.chunks_exact_mut(n).zip(t_means) {
+            channel.iter_mut().for_each(|v| *v -= mean);
+        }
+        // The right windows lie inside the plane for one contiguous range of shifts; their strip
+        // of vectors is converted once.
+        let [bx, by, search, half] = [bx, by, search, half].map(i64::from);
+        let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
+            return scores;
+        };
+        if by - half < 0 || by + half >= i64::from(b.height()) {
+            return scores;
+        }
+        let strip_width = (hi - lo) as usize + side;
+        let mut strip = vec![0.0; CHANNELS * strip_width * side];
+        let origin = [(bx + lo - half) as usize, (by - half) as usize];
+        vector_block(b, origin, [strip_width, side], &mut strip);
+        let mut window = vec![0.0; CHANNELS * n];
+        for (k, dx) in (lo..=hi).enumerate() {
+            let x = bx + dx;
+            if !b.window_valid(x - half..x + half + 1, by - half..by + half + 1) {
+                continue;
+            }
+            for (channel, src) in window
+                .chunks_exact_mut(n)
+                .zip(strip.chunks_exact(strip_width * side))
+            {
+                for (row, src_row) in channel
+                    .chunks_exact_mut(side)
+                    .zip(src.chunks_exact(strip_width))
+                {
+                    row.copy_from_slice(&src_row[k..k + side]);
+                }
+            }
+            let (means, norm) = means_and_norm(&window, &mut squares);
+            if norm <= 0.0 {
+                continue;
+            }
+            let dot: f32 = window
+                .chunks_exact(n)
+                .zip(template.chunks_exact(n))
+                .zip(means)
+                .map(|((w, t), mean)| w.iter().zip(t).map(|(&w, &t)| (w - mean) * t).sum::<f32>())
+                .sum();
+            scores.push((dx as i32, dot / (t_norm * norm)));
+        }
+        scores
+    }
 }
 
-/// Vector width (in `u8` pixels) of [`ncc_scan`]'s cross products.
+/// Vector width (in `u8` pixels) of [`SearchLine::magnitudes`]' cross products.
 const LANES: usize = 8;
 
 /// Σ a·b over two equally long rows whose length is a multiple of [`LANES`]: whole chunks of
@@ -853,18 +868,18 @@ pub fn guided_pair(
     let (lx, ly) = (left[0].round() as i32, left[1].round() as i32);
     let gy = (guess[1] + (ly as f32 - left[1])).round() as i32;
     let gx = (guess[0] + (lx as f32 - left[0])).round() as i32;
+    let line = SearchLine {
+        left_plane,
+        left: [lx, ly],
+        right_plane,
+        guess: [gx, gy],
+        search: search_px,
+        half,
+    };
     let scores = if deformation_px(warp, half) >= SCAN_WARP_PX {
-        ncc_scan_warped(
-            left_plane,
-            [lx, ly],
-            warp,
-            right_plane,
-            [gx, gy],
-            search_px,
-            half,
-        )
+        line.through(warp)
     } else {
-        ncc_scan(left_plane, [lx, ly], right_plane, [gx, gy], search_px, half)
+        line.magnitudes()
     };
     let (best_i, &(best_dx, best)) = scores
         .iter()
@@ -1063,8 +1078,16 @@ mod tests {
                 .unwrap()
         };
         let warp = [stretch, 0.0, 0.0, 1.0];
-        let warped = peak(ncc_scan_warped(&l, [50, 30], &warp, &r, [47, 30], 8, 7));
-        let plain = peak(ncc_scan(&l, [50, 30], &r, [47, 30], 8, 7));
+        let line = SearchLine {
+            left_plane: &l,
+            left: [50, 30],
+            right_plane: &r,
+            guess: [47, 30],
+            search: 8,
+            half: 7,
+        };
+        let warped = peak(line.through(&warp));
+        let plain = peak(line.magnitudes());
         assert_eq!(warped.0, -3, "{warped:?}");
         assert!(
             warped.1 > 0.99 && warped.1 > plain.1,
@@ -1072,7 +1095,7 @@ mod tests {
         );
     }
 
-    /// The direct per-position correlation [`ncc_scan`] must reproduce bit for bit.
+    /// The direct per-position correlation [`SearchLine::magnitudes`] must reproduce bit for bit.
     fn ncc_at(
         a: &SobelPlane,
         [ax, ay]: [i32; 2],
@@ -1137,7 +1160,15 @@ mod tests {
                     (40, 20, 27, 21),
                 ] {
                     for search in [-1, 0, 4, 9] {
-                        let got = ncc_scan(&l, [lx, ly], right, [gx, gy], search, half);
+                        let got = SearchLine {
+                            left_plane: &l,
+                            left: [lx, ly],
+                            right_plane: right,
+                            guess: [gx, gy],
+                            search,
+                            half,
+                        }
+                        .magnitudes();
                         let want: Vec<(i32, f32)> = (-search..=search)
                             .filter_map(|dx| {
                                 Some((dx, ncc_at(&l, [lx, ly], right, [gx + dx, gy], half)?))
