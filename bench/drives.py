@@ -57,13 +57,20 @@ ones, whatever the verge. For each trajectory the untouched frames are cropped t
 *differential, cropped reference* is |est_i - cropped_i - truth_i|, the differential against
 an untouched run that sees the same window.
 
+With --right-row-scale S every sequence runs (both methods, untouched and injected) with its
+calib.toml's right-camera fy divided by 1 + S: the right camera's vertical focal length taken
+as that fraction shorter than the calibration says, the vertical scale between the cameras
+that a rectification can leave. The injection then turns the cameras of that calibration.
+
 The first run makes bench/.venv (python3 -m venv) and installs numpy, opencv-python-headless
 and scipy into it; the script then re-runs itself inside that venv.
 
-Usage: bench/drives.py [--keep] [--csv DIR] [--crop-reference] [-- RUN_ARGS...]
+Usage: bench/drives.py [--keep] [--csv DIR] [--crop-reference] [--right-row-scale S]
+                       [-- RUN_ARGS...]
   --keep      keep the work directory (injected sequences, verge.csv files)
   --csv DIR   write per-frame CSVs (sequence_trajectory.csv) into DIR for further analysis
   --crop-reference  also run the untouched frames cropped to each trajectory's window
+  --right-row-scale S  run with every calib.toml's right fy divided by 1 + S (see above)
   RUN_ARGS    extra flags for every `stereocal run` (e.g. -- --model general)
 """
 
@@ -114,6 +121,28 @@ def read_calib(path):
     import tomllib
     with open(path, "rb") as f:
         return tomllib.load(f)
+
+
+def with_right_row_scale(name, d, scale, work):
+    """A copy of sequence `d` in `work` (its images linked) whose calib.toml has the right
+    camera's fy divided by 1 + `scale`; returns its directory."""
+    import re
+    out = os.path.join(work, f"{name}_row_scaled")
+    os.makedirs(out)
+    for side in ("left", "right"):
+        os.symlink(os.path.abspath(os.path.join(d, side)), os.path.join(out, side))
+    with open(os.path.join(d, "calib.toml")) as f:
+        text = f.read()
+    fy = read_calib(os.path.join(d, "calib.toml"))["right"]["fy"]
+    # The `fy` line of the [right] table, and no other.
+    right = re.search(r"^\[right\]$(.*?)(?=^\[|\Z)", text, re.M | re.S)
+    line = re.compile(r"^fy\s*=.*$", re.M)
+    if right is None or not line.search(right.group(1)):
+        raise SystemExit(f"{name}: calib.toml has no [right] fy line to scale")
+    body = line.sub(f"fy = {fy / (1.0 + scale)!r}", right.group(1), count=1)
+    with open(os.path.join(out, "calib.toml"), "w") as f:
+        f.write(text[:right.start(1)] + body + text[right.end(1):])
+    return out
 
 
 def read_truth(path):
@@ -383,6 +412,8 @@ def main():
     ap.add_argument("--csv", help="write per-frame CSVs into this directory")
     ap.add_argument("--crop-reference", action="store_true",
                     help="also run the untouched frames cropped to each trajectory's window")
+    ap.add_argument("--right-row-scale", type=float, metavar="S",
+                    help="run with every calib.toml's right fy divided by 1 + S")
     args = ap.parse_args(argv)
 
     data = real_data()
@@ -399,6 +430,8 @@ def main():
     try:
         sign_check(binary, work)
         for name, d in rectified_sequences(data):
+            if args.right_row_scale is not None:
+                d = with_right_row_scale(name, d, args.right_row_scale, work)
             print(f"{name}: untouched", file=sys.stderr)
             seq_args = run_args
             if "--fps" not in run_args:
@@ -464,6 +497,8 @@ def main():
     f = lambda v: "-" if v is None else "%.3f°" % v
     t = TARGETS
     flags = " ".join(run_args) if run_args else "default settings"
+    if args.right_row_scale is not None:
+        flags += f"; right fy divided by 1 + {args.right_row_scale:g}"
     print(f"Real drives, `stereocal run` ({flags}) vs a verge-only fit to OpenCV "
           f"{cv2.__version__} SIFT matches (ratio {RATIO}, 3-point RANSAC {RANSAC_PX} px, "
           f"Huber {HUBER_PX} px), same frames and calib.toml. Degrees; ours / SIFT.\n")
