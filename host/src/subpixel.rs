@@ -668,16 +668,10 @@ impl SearchLine<'_> {
     /// convert to `f32` exactly; u32 holds them up to windows of 257x257. Products are taken in
     /// `u16` (255² fits), which the compiler vectorises with plain SSE2.
     fn magnitudes(&self) -> Vec<(i32, f32)> {
-        let Self {
-            left_plane: a,
-            left: [ax, ay],
-            right_plane: b,
-            guess: [bx, by],
-            search,
-            half,
-        } = *self;
+        let (a, b) = (self.left_plane, self.right_plane);
         let mut scores = Vec::new();
-        let [ax, ay, bx, by, search, half] = [ax, ay, bx, by, search, half].map(i64::from);
+        let [[ax, ay], [bx, by]] = [self.left, self.guess].map(|p| p.map(i64::from));
+        let [search, half] = [self.search, self.half].map(i64::from);
         let inside = |p: &SobelPlane, x: i64, y: i64| {
             x - half >= 0
                 && y - half >= 0
@@ -760,14 +754,7 @@ impl SearchLine<'_> {
     /// a large verge a window near the image's edge is stretched by tens of per cent between
     /// the views, which no whole-pixel shift of the unwarped window aligns.
     fn through(&self, warp: &Warp) -> Vec<(i32, f32)> {
-        let Self {
-            left_plane: a,
-            left: [ax, ay],
-            right_plane: b,
-            guess: [bx, by],
-            search,
-            half,
-        } = *self;
+        let (a, [ax, ay], b, half) = (self.left_plane, self.left, self.right_plane, self.half);
         let mut scores = Vec::new();
         let Some(inverse) = inverse(warp) else {
             return scores;
@@ -788,7 +775,8 @@ impl SearchLine<'_> {
         }
         // The right windows lie inside the plane for one contiguous range of shifts; their strip
         // of vectors is converted once.
-        let [bx, by, search, half] = [bx, by, search, half].map(i64::from);
+        let [bx, by, search, half] =
+            [self.guess[0], self.guess[1], self.search, half].map(i64::from);
         let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
             return scores;
         };
