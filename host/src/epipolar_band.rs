@@ -92,7 +92,7 @@ const GRID_STEP_PX: f32 = 16.0;
 /// keypoint of every frame and fills in once, but the band near a first fit's pose only sorts
 /// that fit's few hundred matches, which read a fraction of its nodes, and a moving head needs
 /// a new one every few frames.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct EpipolarBand {
     /// Grid nodes per row and per column.
     nodes: [usize; 2],
@@ -164,7 +164,7 @@ impl EpipolarBand {
 }
 
 /// One pose: `x_r = rotation · x_l + translation` for camera coordinates (unit baseline).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Pose {
     rotation: Matrix3<f64>,
     translation: Vector3<f64>,
@@ -209,7 +209,7 @@ fn poses(calib: &Calibration, range: &PoseRange) -> Vec<Pose> {
 }
 
 /// The right image's columns in calibrated coordinates (the extent of its border).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct ImageBounds {
     x: [f64; 2],
 }
