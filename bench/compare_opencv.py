@@ -32,7 +32,11 @@ Time is wall time per frame pair without PNG decoding on both sides (stereocal's
 command, decoding included, is also timed, in a table of its own): stereocal's
 ms_per_frame_pair covers fabric model, driver, estimator and filter (decoding runs in another
 thread); OpenCV's covers SIFT on both images, matching, E and pose (images are decoded
-before the clock starts). One run each, on a shared 2-core machine: the figures are noisy.
+before the clock starts). Each scene runs RUNS rounds, stereocal then OpenCV in each, so that
+both methods see the same spells of a shared machine: the table gives each method's median
+time over the rounds and the speed-up as the ratio of the medians, with the range of the
+rounds' own ratios beside it. Errors are from the first round (stereocal's are the same in
+every round).
 
 The first run makes bench/.venv (python3 -m venv) and installs numpy and
 opencv-python-headless into it; the script then re-runs itself inside that venv.
@@ -53,7 +57,7 @@ SCENES = (("terrace", None), ("playground", None), ("playground", (1352, 392)))
 MOTION = "moving"
 RATIO = 0.8
 MIN_POINTS = 5  # fewest ratio-test matches to try E; fewest points in front for a "firm" pose
-RUNS = 3  # whole `stereocal run` commands timed per scene
+RUNS = 3  # rounds per scene: a whole `stereocal run` command, then OpenCV on the same frames
 
 
 def in_venv():
@@ -327,15 +331,22 @@ def main():
                    "--calib", os.path.join(seq, "calib.toml"),
                    "--truth", os.path.join(seq, "truth.csv"),
                    "--out", os.path.join(work, f"out_{scene}"), "--json"]
-            # The whole command, process start to exit (PNG decoding and the written
-            # verge.csv / verge.png included), RUNS times: its pairs/s, slowest to fastest.
-            walls = []
+            # RUNS rounds, each the whole command (process start to exit, PNG decoding and
+            # the written verge.csv / verge.png included) and then OpenCV: the whole command's
+            # pairs/s slowest to fastest, both methods' median per-pair times, and the
+            # rounds' own ratios.
+            walls, rounds = [], []
             for _ in range(RUNS):
                 t0 = time.perf_counter()
-                sc = json.loads(sh(run))
+                sc_round = json.loads(sh(run))
                 walls.append(time.perf_counter() - t0)
+                rounds.append((sc_round, run_opencv(seq)))
+            sc, cvr = rounds[0]
             sc["whole_pairs_per_s"] = sorted(sc["frames"] / w for w in walls)
-            cvr = run_opencv(seq)
+            sc["ms_per_frame_pair"] = float(np.median([r[0]["ms_per_frame_pair"] for r in rounds]))
+            cvr["ms_per_frame_pair"] = float(np.median([r[1]["ms_per_frame_pair"] for r in rounds]))
+            sc["round_ratios"] = sorted(c["ms_per_frame_pair"] / o["ms_per_frame_pair"]
+                                        for o, c in rounds)
             size = cv2.imread(os.path.join(seq, "left", sorted(os.listdir(
                 os.path.join(seq, "left")))[0]), cv2.IMREAD_GRAYSCALE).shape
             rows.append((scene, f"{size[1]}x{size[0]}", sc, cvr))
@@ -360,7 +371,8 @@ def main():
     for scene, size, sc, cvr in rows:
         ratio = cvr["ms_per_frame_pair"] / sc["ms_per_frame_pair"]
         firm = dict(cvr["firm"], ms_per_frame_pair=cvr["ms_per_frame_pair"])
-        for name, r, extra in (("stereocal", sc, "%.1fx" % ratio),
+        spread = "%.1f–%.1f" % (sc["round_ratios"][0], sc["round_ratios"][-1])
+        for name, r, extra in (("stereocal", sc, "%.1fx (%s)" % (ratio, spread)),
                                ("OpenCV SIFT + 5-pt RANSAC", cvr, "-"),
                                (f"OpenCV, firm poses only (>= {MIN_POINTS} pts in front)",
                                 firm, "-")):
@@ -380,7 +392,9 @@ def main():
     for scene, size, sc, _ in rows:
         rates = ", ".join("%.1f" % r for r in sc["whole_pairs_per_s"])
         print(f"| {scene} | {size} | {sc['frames']} | {rates} |")
-    print(f"\nTimes: wall ms per pair, the last of the {RUNS} runs for stereocal, PNG decoding excluded on both sides (stereocal: "
+    print(f"\nTimes: wall ms per pair, the median of {RUNS} alternated rounds for each method "
+          f"(speed-up: the ratio of the medians; in brackets the range of the rounds' own "
+          f"ratios), PNG decoding excluded on both sides (stereocal: "
           f"fabric model + driver + estimator + filter; OpenCV: SIFT on both images + matching "
           f"+ E + pose, {cv2.getNumThreads()} OpenCV threads). Measured on a "
           f"{os.cpu_count()}-core machine shared with other jobs ({platform.machine()}): "
