@@ -341,12 +341,13 @@ def main():
                 sc_round = json.loads(sh(run))
                 walls.append(time.perf_counter() - t0)
                 rounds.append((sc_round, run_opencv(seq)))
+            ours_ms = [o["ms_per_frame_pair"] for o, _ in rounds]
+            cv_ms = [c["ms_per_frame_pair"] for _, c in rounds]
             sc, cvr = rounds[0]
             sc["whole_pairs_per_s"] = sorted(sc["frames"] / w for w in walls)
-            sc["ms_per_frame_pair"] = float(np.median([r[0]["ms_per_frame_pair"] for r in rounds]))
-            cvr["ms_per_frame_pair"] = float(np.median([r[1]["ms_per_frame_pair"] for r in rounds]))
-            sc["round_ratios"] = sorted(c["ms_per_frame_pair"] / o["ms_per_frame_pair"]
-                                        for o, c in rounds)
+            sc["round_ratios"] = sorted(c / o for o, c in zip(ours_ms, cv_ms))
+            sc["ms_per_frame_pair"] = float(np.median(ours_ms))
+            cvr["ms_per_frame_pair"] = float(np.median(cv_ms))
             size = cv2.imread(os.path.join(seq, "left", sorted(os.listdir(
                 os.path.join(seq, "left")))[0]), cv2.IMREAD_GRAYSCALE).shape
             rows.append((scene, f"{size[1]}x{size[0]}", sc, cvr))
