@@ -131,9 +131,10 @@ def with_right_row_scale(name, d, scale, work):
     os.makedirs(out)
     for side in ("left", "right"):
         os.symlink(os.path.abspath(os.path.join(d, side)), os.path.join(out, side))
+    import tomllib
     with open(os.path.join(d, "calib.toml")) as f:
         text = f.read()
-    fy = read_calib(os.path.join(d, "calib.toml"))["right"]["fy"]
+    fy = tomllib.loads(text)["right"]["fy"]
     # The `fy` line of the [right] table, and no other.
     right = re.search(r"^\[right\]$(.*?)(?=^\[|\Z)", text, re.M | re.S)
     line = re.compile(r"^fy\s*=.*$", re.M)

@@ -644,7 +644,6 @@ fn refine_in(
 /// against the right plane's windows centred on (`guess[0] + dx`, `guess[1]`) for `dx` in
 /// `-search..=search`, as [`SearchLine::magnitudes`] or [`SearchLine::through`] a warp
 /// correlates them.
-#[derive(Clone, Copy)]
 struct SearchLine<'a> {
     left_plane: &'a SobelPlane,
     left: [i32; 2],
@@ -655,6 +654,11 @@ struct SearchLine<'a> {
 }
 
 impl SearchLine<'_> {
+    /// The windows' side in pixels.
+    fn side(&self) -> usize {
+        (2 * self.half + 1) as usize
+    }
+
     /// Normalised cross-correlations of the left window's magnitudes with each right window's,
     /// in `dx` order; positions whose window leaves its plane or where either window is flat
     /// are left out.
@@ -686,7 +690,7 @@ impl SearchLine<'_> {
         if !inside(a, ax, ay) || !inside(b, bx + lo, by) {
             return scores;
         }
-        let len = (2 * half + 1) as usize;
+        let len = self.side();
         let row_a = |r: usize| {
             let start = (ay - half) as usize + r;
             &a.magnitude()[start * a.width() as usize + (ax - half) as usize..][..len]
@@ -759,7 +763,7 @@ impl SearchLine<'_> {
         let Some(inverse) = inverse(warp) else {
             return scores;
         };
-        let side = (2 * half + 1) as usize;
+        let side = self.side();
         let n = side * side;
         let mut template = vec![0.0; CHANNELS * n];
         if sample_warped(a, ax as f32, ay as f32, half, &inverse, &mut template).is_none() {
