@@ -660,8 +660,8 @@ impl SearchLine<'_> {
     }
 
     /// Normalised cross-correlations of the left window's magnitudes with each right window's,
-    /// in `dx` order; positions whose window leaves its plane or where either window is flat
-    /// are left out.
+    /// in `dx` order; positions whose window leaves its plane or touches a pixel the link lost,
+    /// or where either window is flat, are left out.
     ///
     /// Every sum is an integer sum, exact in any order, so each value equals a direct
     /// per-position computation bit for bit (see the tests); what differs is that the left
@@ -681,13 +681,16 @@ impl SearchLine<'_> {
                 && y - half >= 0
                 && x + half < i64::from(p.width())
                 && y + half < i64::from(p.height())
-                && p.window_valid(x - half..x + half + 1, y - half..y + half + 1)
         };
-        // The right window lies inside its plane for one contiguous range of shifts.
+        let valid = |p: &SobelPlane, x: i64, y: i64| {
+            p.window_valid(x - half..x + half + 1, y - half..y + half + 1)
+        };
+        // The right window lies inside its plane for one contiguous range of shifts; whether it
+        // touches a pixel the link lost is each shift's own question.
         let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
             return scores;
         };
-        if !inside(a, ax, ay) || !inside(b, bx + lo, by) {
+        if !inside(a, ax, ay) || !valid(a, ax, ay) || !inside(b, bx + lo, by) {
             return scores;
         }
         let len = self.side();
@@ -735,6 +738,9 @@ impl SearchLine<'_> {
             sb[..strip_len].copy_from_slice(row_b(r));
         }
         for (k, dx) in (lo..=hi).enumerate() {
+            if !valid(b, bx + dx, by) {
+                continue;
+            }
             let sb = col_b[k..k + len].iter().sum::<u32>() as f32;
             let sbb = col_bb[k..k + len].iter().sum::<u32>() as f32;
             let sab: u32 = window_a
@@ -1018,6 +1024,42 @@ mod tests {
             let inside = l.clone().with_valid(losing(30, 45..80));
             assert!(refine(&inside, &r).is_none());
         }
+    }
+
+    #[test]
+    fn a_lost_segment_costs_the_guided_scan_only_the_shifts_that_reach_it() {
+        let l = plane(100, 60, 0.0, 0.0, 1.0);
+        let r = plane(100, 60, -6.4, 0.3, 1.0);
+        // Columns 28..34 of row 30 lost: the right windows of shifts -8..=-7 from column 47
+        // (centres 39 and 40, 15 wide) reach them, those of -6..=8 do not.
+        let valid: Vec<bool> = (0..60u32)
+            .flat_map(|y| (0..100u32).map(move |x| y != 30 || !(28..34).contains(&x)))
+            .collect();
+        let damaged = r.clone().with_valid(valid);
+        let line = |right_plane| SearchLine {
+            left_plane: &l,
+            left: [50, 30],
+            right_plane,
+            guess: [47, 30],
+            search: 8,
+            half: 7,
+        };
+        let intact = line(&r).magnitudes();
+        let kept: Vec<(i32, f32)> = intact.iter().copied().filter(|&(dx, _)| dx >= -6).collect();
+        assert_eq!(intact.len(), 17);
+        assert_eq!(line(&damaged).magnitudes(), kept);
+        // The match, 3.4 px left of the guess, is found beside the lost segment.
+        let got = guided_pair(
+            &l,
+            &damaged,
+            [50.0, 30.0],
+            [47.0, 30.0],
+            8,
+            &IDENTITY,
+            &SubpixelConfig::default(),
+        )
+        .expect("the match beside the lost segment");
+        assert!((got.right[0] - (got.left[0] - 6.4)).abs() < 0.05, "{got:?}");
     }
 
     #[test]
