@@ -19,6 +19,11 @@
 // bytes, and at the body's end, its 16 parity bytes go to a parity memory. After the body the
 // parity bytes go out seven bits at a time, most significant first, each group with bit 7
 // set, the last group's unused low bits 0; then the delimiter.
+//
+// Both memories have one write port and one read port whose data follows its address by a
+// clock, the form block RAM takes (a 7 Series' RAMB18/36, an iCE40's SB_RAM40_4K): every state
+// presents the address it reads on the next clock, so the memories cost no clock. The parity
+// memory holds a block's 16 parity bytes as one 128-bit row, written whole when the block ends.
 `default_nettype none
 
 module sc_framer #(
@@ -64,8 +69,8 @@ module sc_framer #(
     // RS shift register: rs[0] the highest degree; the block's bytes so far.
     reg  [7:0]    rs [0:15];
     reg  [7:0]    in_block;             // 0..239
-    reg  [7:0]    par [0:16*BLOCKS-1];
-    reg  [PW-1:0] par_n;                // parity bytes stored
+    reg  [127:0]  par [0:BLOCKS-1];     // a block's parity bytes, byte r at bits 8r..8r+7
+    reg  [PW-1:0] par_n;                // parity bytes stored (16 per row)
     reg  [PW-1:0] par_at;               // parity bytes packed
     reg  [14:0]   bits;                 // packer: bits held, right-aligned
     reg  [3:0]    held;
@@ -109,19 +114,45 @@ module sc_framer #(
     endfunction
 
     // ------------------------------------------------------------------------------------
+    // The packet memory: written at `n` while the packet and its CRC arrive; `q` is the byte
+    // at the address `ra` presented on the clock before.
+    wire          we = !rst && (state == S_IN && in_valid || state == S_CRC);
+    wire [7:0]    wd = state == S_IN ? in_data : ~crc[8*crc_at +: 8];
+    reg  [AW-1:0] ra;
+    reg  [7:0]    q;
+    always @(posedge clk) begin
+        if (we) mem[n] <= wd;
+        q <= mem[ra];
+    end
+
+    // ------------------------------------------------------------------------------------
     // What goes out now.
-    wire [AW-1:0] at = p + {{(AW-8){1'b0}}, k};          // the byte the scan looks at
-    wire [AW-1:0] data_at = p + {{(AW-8){1'b0}}, j};
-    wire          scan_stops = k == 8'd254 || at >= n || mem[at] == 8'd0;
+    wire [AW-1:0] at = p + {{(AW-8){1'b0}}, k};          // the byte the scan looks at (in q)
+    wire [AW-1:0] data_at = p + {{(AW-8){1'b0}}, j};     // the byte going out (in q)
+    wire          scan_stops = k == 8'd254 || at >= n || q == 8'd0;
     wire          body_byte = (state == S_CODE || state == S_DATA) && out_valid && out_ready;
     wire [7:0]    fb = out_data ^ rs[0];
+
+    // The address for the next clock: the scan's next byte, the data byte that goes out next
+    // (the next one once this one is taken), and where the next scan or block starts.
+    always @(*) begin
+        case (state)
+            S_CRC: ra = {AW{1'b0}};
+            S_SCAN: ra = at + 1'b1;
+            S_CODE: ra = p;
+            S_DATA: if (j != k) ra = data_at + {{(AW-1){1'b0}}, out_ready};
+                    else if (k == 8'd254) ra = at;
+                    else ra = at + 1'b1;
+            default: ra = {AW{1'b0}};
+        endcase
+    end
 
     always @(*) begin
         out_valid = 1'b0;
         out_data = 8'd0;
         case (state)
             S_CODE: begin out_valid = 1'b1; out_data = k + 8'd1; end
-            S_DATA: begin out_valid = j != k; out_data = mem[data_at]; end
+            S_DATA: begin out_valid = j != k; out_data = q; end
             S_PACK: begin
                 out_valid = held >= 4'd7 || par_at == par_n && held != 4'd0;
                 out_data = held >= 4'd7 ? {1'b1, bits[held - 4'd7 +: 7]}
@@ -131,6 +162,35 @@ module sc_framer #(
             default: ;
         endcase
     end
+
+    // ------------------------------------------------------------------------------------
+    // The parity memory: a row is written when a block ends inside the body (its parity is
+    // the shift register after the block's last byte) or at the body's end (the register as it
+    // stands). The packer reads the row of the byte it packs next: a byte loaded gives it at
+    // least seven bits to send, so a clock always lies between two loads, and the row read
+    // there is the next byte's. A row read on the clock it is written (the body's only block,
+    // at its end) comes from the written data.
+    wire          block_end = body_byte && protect && in_block == 8'd238;
+    wire          par_we = !rst && (block_end || state == S_PARITY && protect && in_block != 8'd0);
+    wire [PW-5:0] par_wa = par_n[PW-1:4];
+    wire [PW-5:0] par_ra = state == S_PACK ? par_at[PW-1:4] : {(PW-4){1'b0}};
+    reg  [127:0]  par_wd;
+    reg  [127:0]  par_q;
+    reg  [127:0]  par_wd_q;
+    reg           par_bypass;
+    integer       g;
+    always @(*) begin
+        for (g = 0; g < 15; g = g + 1)
+            par_wd[8*g +: 8] = block_end ? rs[g + 1] ^ gf_mul(fb, gen(g)) : rs[g];
+        par_wd[120 +: 8] = block_end ? gf_mul(fb, gen(15)) : rs[15];
+    end
+    always @(posedge clk) begin
+        if (par_we) par[par_wa] <= par_wd;
+        par_q <= par[par_ra];
+        par_bypass <= par_we && par_wa == par_ra;
+        par_wd_q <= par_wd;
+    end
+    wire [127:0]  par_row = par_bypass ? par_wd_q : par_q;
 
     integer r;
     always @(posedge clk) begin
@@ -142,7 +202,6 @@ module sc_framer #(
             case (state)
                 S_IN: if (in_valid) begin
                     if (n == {AW{1'b0}}) protect <= fec;
-                    mem[n] <= in_data;
                     n <= n + 1'b1;
                     crc <= crc_byte(crc, in_data);
                     if (in_last) begin
@@ -151,7 +210,6 @@ module sc_framer #(
                     end
                 end
                 S_CRC: begin
-                    mem[n] <= ~crc[8*crc_at +: 8];
                     n <= n + 1'b1;
                     crc_at <= crc_at + 2'd1;
                     if (crc_at == 2'd3) begin
@@ -185,10 +243,7 @@ module sc_framer #(
                     state <= S_SCAN;
                 end
                 S_PARITY: begin
-                    if (protect && in_block != 8'd0) begin
-                        for (r = 0; r < 16; r = r + 1) par[par_n + r[PW-1:0]] <= rs[r];
-                        par_n <= par_n + ECC;
-                    end
+                    if (protect && in_block != 8'd0) par_n <= par_n + ECC;
                     par_at <= {PW{1'b0}};
                     bits <= 15'd0;
                     held <= 4'd0;
@@ -201,7 +256,7 @@ module sc_framer #(
                             else held <= 4'd0;
                         end
                     end else if (par_at != par_n) begin
-                        bits <= {bits[6:0], par[par_at]};
+                        bits <= {bits[6:0], par_row[8*par_at[3:0] +: 8]};
                         held <= held + 4'd8;
                         par_at <= par_at + 1'b1;
                     end else begin
@@ -221,9 +276,6 @@ module sc_framer #(
                 if (in_block == 8'd238) begin
                     // The block's last byte: its parity goes to the memory, the register
                     // starts over.
-                    for (r = 0; r < 15; r = r + 1)
-                        par[par_n + r[PW-1:0]] <= rs[r + 1] ^ gf_mul(fb, gen(r));
-                    par[par_n + ECC - 1'b1] <= gf_mul(fb, gen(15));
                     par_n <= par_n + ECC;
                     in_block <= 8'd0;
                     for (r = 0; r < 16; r = r + 1) rs[r] <= 8'd0;

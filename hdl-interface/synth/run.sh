@@ -163,9 +163,8 @@ do_job() {
     fi
 
     # The stream engine's memories (its row ring alone is 609 Kbit at 640 px) fit no iCE40's
-    # block RAM, and its framer's packet memory is read combinationally: yosys maps them to
-    # logic cells there and does not finish in SYNTH_TIMEOUT. The framer is reported inside
-    # the engine.
+    # block RAM: yosys maps them to logic cells there and does not finish in SYNTH_TIMEOUT.
+    # The framer is reported inside the engine.
     if [ "$devs" = xc7 ]; then
         status "$name" ice40 skipped 0 "memories beyond any iCE40's block RAM: 7 Series only"
         return
