@@ -10,20 +10,22 @@
 // last byte. A packet is at most MAXLEN - 4 bytes (the wire's MAX_PACKET_LEN minus its CRC);
 // IN_READY stays 0 while a frame is being sent.
 //
-// How: the packet and its CRC go into a byte memory while they arrive (one byte per clock).
-// COBS then works block by block: a scan counts the bytes up to the next zero, the end, or
-// 254 bytes (one clock per byte), the block's code goes out, then its bytes; a zero ends a
-// block and is not sent, a packet ending in a zero gets a last empty block (code 0x01), and
-// a full block (code 0xFF) at the end gets none. Every body byte that goes out also steps the
+// How: the packet and its CRC go into a byte memory while they arrive (one byte per clock),
+// and COBS's block codes into a code memory as the bytes that end the blocks arrive: a zero
+// ends a block (code: its length plus one; the zero is not sent), a 254th non-zero byte ends
+// a full one (code 0xFF), and the clock after the last byte ends the last block, except after
+// a full one (a packet ending in a zero gets a last empty block, code 0x01). Then each block's
+// code goes out and its bytes, one per clock. Every body byte that goes out also steps the
 // RS shift register (generator (x - 2^0)..(x - 2^15) over GF(2^8) mod 0x11D); each 239
 // bytes, and at the body's end, its 16 parity bytes go to a parity memory. After the body the
 // parity bytes go out seven bits at a time, most significant first, each group with bit 7
 // set, the last group's unused low bits 0; then the delimiter.
 //
-// Both memories have one write port and one read port whose data follows its address by a
-// clock, the form block RAM takes (a 7 Series' RAMB18/36, an iCE40's SB_RAM40_4K): every state
-// presents the address it reads on the next clock, so the memories cost no clock. The parity
-// memory holds a block's 16 parity bytes as one 128-bit row, written whole when the block ends.
+// The three memories have one write port and one read port whose data follows its address by
+// a clock, the form block RAM takes (a 7 Series' RAMB18/36, an iCE40's SB_RAM40_4K): every
+// state presents the addresses it reads on the next clock, so the memories cost no clock. The
+// parity memory holds a block's 16 parity bytes as one 128-bit row, written whole when the
+// block ends.
 `default_nettype none
 
 module sc_framer #(
@@ -49,18 +51,25 @@ module sc_framer #(
 
     localparam [3:0] S_IN = 4'd0,       // taking the packet's bytes
                      S_CRC = 4'd1,      // storing the 4 CRC bytes
-                     S_SCAN = 4'd2,     // counting the block's bytes
+                     S_LAST = 4'd2,     // the last block's code into the code memory
                      S_CODE = 4'd3,     // sending the block's code
                      S_DATA = 4'd4,     // sending the block's bytes
                      S_PARITY = 4'd5,   // the last block's parity into the memory
                      S_PACK = 4'd6,     // sending the packed parity
-                     S_DELIM = 4'd7;    // sending the delimiter
+                     S_DELIM = 4'd7,    // sending the delimiter
+                     S_FIRST = 4'd8;    // reading the first code
 
     reg  [3:0]    state;
     reg  [7:0]    mem [0:MAXLEN-1];
     reg  [AW-1:0] n;                    // bytes stored (packet, then packet and CRC)
+    reg  [7:0]    cm [0:MAXLEN];        // block codes: at most one per byte, and the last
+    reg  [AW-1:0] cn;                   // codes stored
+    reg  [7:0]    run;                  // non-zero bytes of the block being stored, 0..253
+    reg           full_end;             // the last byte stored ended a full block
+    reg  [AW-1:0] ci;                   // the code being sent
     reg  [AW-1:0] p;                    // the block's first byte
     reg  [7:0]    k;                    // the block's length, 0..254
+    reg           skip;                 // a zero ends the block (not sent)
     reg  [7:0]    j;                    // bytes of the block sent
     reg  [1:0]    crc_at;               // CRC byte being stored
     reg  [31:0]   crc;
@@ -125,25 +134,42 @@ module sc_framer #(
         q <= mem[ra];
     end
 
+    // The code memory: a code is written at `cn` by the byte that ends its block, or on
+    // S_LAST; `cq` is the code at `cra` presented on the clock before. S_FIRST reads the first
+    // code on the clock after S_LAST's write, which may be that code.
+    wire          ends_zero = we && wd == 8'd0;
+    wire          ends_full = we && wd != 8'd0 && run == 8'd253;
+    wire          cwe = ends_zero || ends_full || !rst && state == S_LAST && !full_end;
+    wire [7:0]    cwd = ends_full ? 8'hFF : run + 8'd1;
+    reg  [AW-1:0] cra;
+    reg  [7:0]    cq;
+    always @(posedge clk) begin
+        if (cwe) cm[cn] <= cwd;
+        cq <= cm[cra];
+    end
+
     // ------------------------------------------------------------------------------------
     // What goes out now.
-    wire [AW-1:0] at = p + {{(AW-8){1'b0}}, k};          // the byte the scan looks at (in q)
+    wire [AW-1:0] at = p + {{(AW-8){1'b0}}, k};          // the block's end
     wire [AW-1:0] data_at = p + {{(AW-8){1'b0}}, j};     // the byte going out (in q)
-    wire          scan_stops = k == 8'd254 || at >= n || q == 8'd0;
+    wire [AW-1:0] next_p = at + {{(AW-1){1'b0}}, skip};  // the next block's first byte
     wire          body_byte = (state == S_CODE || state == S_DATA) && out_valid && out_ready;
     wire [7:0]    fb = out_data ^ rs[0];
 
-    // The address for the next clock: the scan's next byte, the data byte that goes out next
-    // (the next one once this one is taken), and where the next scan or block starts.
+    // The addresses for the next clock: the block's first byte and its code, the data byte
+    // that goes out next (the next one once this one is taken), and at a block's end the next
+    // block's first byte and code.
     always @(*) begin
+        ra = {AW{1'b0}};
+        cra = ci;
         case (state)
-            S_CRC: ra = {AW{1'b0}};
-            S_SCAN: ra = at + 1'b1;
             S_CODE: ra = p;
             S_DATA: if (j != k) ra = data_at + {{(AW-1){1'b0}}, out_ready};
-                    else if (k == 8'd254) ra = at;
-                    else ra = at + 1'b1;
-            default: ra = {AW{1'b0}};
+                    else begin
+                        ra = next_p;
+                        cra = ci + 1'b1;
+                    end
+            default: ;
         endcase
     end
 
@@ -151,7 +177,7 @@ module sc_framer #(
         out_valid = 1'b0;
         out_data = 8'd0;
         case (state)
-            S_CODE: begin out_valid = 1'b1; out_data = k + 8'd1; end
+            S_CODE: begin out_valid = 1'b1; out_data = cq; end
             S_DATA: begin out_valid = j != k; out_data = q; end
             S_PACK: begin
                 out_valid = held >= 4'd7 || par_at == par_n && held != 4'd0;
@@ -198,7 +224,16 @@ module sc_framer #(
             state <= S_IN;
             n <= {AW{1'b0}};
             crc <= 32'hFFFF_FFFF;
+            cn <= {AW{1'b0}};
+            run <= 8'd0;
+            full_end <= 1'b0;
         end else begin
+            // Every byte stored: a zero or a full block's last byte ends the block.
+            if (we) begin
+                run <= ends_zero || ends_full ? 8'd0 : run + 8'd1;
+                full_end <= ends_full;
+            end
+            if (cwe) cn <= cn + 1'b1;
             case (state)
                 S_IN: if (in_valid) begin
                     if (n == {AW{1'b0}}) protect <= fec;
@@ -212,35 +247,30 @@ module sc_framer #(
                 S_CRC: begin
                     n <= n + 1'b1;
                     crc_at <= crc_at + 2'd1;
-                    if (crc_at == 2'd3) begin
-                        state <= S_SCAN;
-                        p <= {AW{1'b0}};
-                        k <= 8'd0;
-                        in_block <= 8'd0;
-                        par_n <= {PW{1'b0}};
-                        for (r = 0; r < 16; r = r + 1) rs[r] <= 8'd0;
-                    end
+                    if (crc_at == 2'd3) state <= S_LAST;
                 end
-                S_SCAN: if (scan_stops) state <= S_CODE;
-                        else k <= k + 8'd1;
+                S_LAST: begin
+                    state <= S_FIRST;
+                    ci <= {AW{1'b0}};
+                    p <= {AW{1'b0}};
+                    in_block <= 8'd0;
+                    par_n <= {PW{1'b0}};
+                    for (r = 0; r < 16; r = r + 1) rs[r] <= 8'd0;
+                end
+                S_FIRST: state <= S_CODE;
                 S_CODE: if (out_ready) begin
                     state <= S_DATA;
+                    k <= cq - 8'd1;
+                    skip <= cq != 8'hFF;
                     j <= 8'd0;
                 end
                 S_DATA: if (j != k) begin
                     if (out_ready) j <= j + 8'd1;
-                end else if (k == 8'd254) begin
-                    // A full block: the next one starts behind it; none after the last.
-                    p <= at;
-                    k <= 8'd0;
-                    state <= at == n ? S_PARITY : S_SCAN;
-                end else if (at == n) begin
-                    state <= S_PARITY;
                 end else begin
-                    // A zero ended the block: it is not sent; a block follows, if empty.
-                    p <= at + 1'b1;
-                    k <= 8'd0;
-                    state <= S_SCAN;
+                    // The block's end; a zero that ended it is not sent.
+                    p <= next_p;
+                    ci <= ci + 1'b1;
+                    state <= ci + 1'b1 == cn ? S_PARITY : S_CODE;
                 end
                 S_PARITY: begin
                     if (protect && in_block != 8'd0) par_n <= par_n + ECC;
@@ -267,6 +297,9 @@ module sc_framer #(
                     state <= S_IN;
                     n <= {AW{1'b0}};
                     crc <= 32'hFFFF_FFFF;
+                    cn <= {AW{1'b0}};
+                    run <= 8'd0;
+                    full_end <= 1'b0;
                 end
                 default: state <= S_IN;
             endcase

@@ -28,8 +28,8 @@ fn skipped(name: &str) -> bool {
     false
 }
 
-/// A camera at a sixteenth of the fabric's clock with a quarter line of blanking: the engine
-/// keeps up, and every byte is the model's.
+/// A camera at a thirty-second of the fabric's clock with a quarter line of blanking: the
+/// engine keeps up, and every byte is the model's.
 #[test]
 fn the_rtl_engine_sends_the_models_bytes() {
     if skipped("stream engine co-simulation") {
@@ -45,7 +45,7 @@ fn the_rtl_engine_sends_the_models_bytes() {
             let mut model = stream_model();
             let mut rtl = RtlFabric::new(seed as u32);
             let clocking = Clocking {
-                ratio: 64,
+                ratio: 32,
                 line_blank: 16,
                 link_stalls: 100,
             };
