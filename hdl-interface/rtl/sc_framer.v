@@ -23,9 +23,9 @@
 //
 // The three memories have one write port and one read port whose data follows its address by
 // a clock, the form block RAM takes (a 7 Series' RAMB18/36, an iCE40's SB_RAM40_4K): every
-// state presents the addresses it reads on the next clock, so the memories cost no clock. The
-// parity memory holds a block's 16 parity bytes as one 128-bit row, written whole when the
-// block ends.
+// state presents the addresses it reads on the next clock, so the memories cost one clock a
+// packet (S_FIRST, which reads the first code after S_LAST wrote the last). The parity memory
+// holds a block's 16 parity bytes as one 128-bit row, written whole when the block ends.
 `default_nettype none
 
 module sc_framer #(
