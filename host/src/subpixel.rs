@@ -659,6 +659,14 @@ impl SearchLine<'_> {
         (2 * self.half + 1) as usize
     }
 
+    /// Whether the right window centred on column `x` of the guess's row touches no pixel the
+    /// link lost.
+    fn right_valid(&self, x: i64) -> bool {
+        let [y, half] = [self.guess[1], self.half].map(i64::from);
+        self.right_plane
+            .window_valid(x - half..x + half + 1, y - half..y + half + 1)
+    }
+
     /// Normalised cross-correlations of the left window's magnitudes with each right window's,
     /// in `dx` order; positions whose window leaves its plane or touches a pixel the link lost,
     /// or where either window is flat, are left out.
@@ -682,15 +690,15 @@ impl SearchLine<'_> {
                 && x + half < i64::from(p.width())
                 && y + half < i64::from(p.height())
         };
-        let valid = |p: &SobelPlane, x: i64, y: i64| {
-            p.window_valid(x - half..x + half + 1, y - half..y + half + 1)
-        };
         // The right window lies inside its plane for one contiguous range of shifts; whether it
         // touches a pixel the link lost is each shift's own question.
         let Some((lo, hi)) = shifts_inside(b, bx, search, half) else {
             return scores;
         };
-        if !inside(a, ax, ay) || !valid(a, ax, ay) || !inside(b, bx + lo, by) {
+        if !inside(a, ax, ay)
+            || !a.window_valid(ax - half..ax + half + 1, ay - half..ay + half + 1)
+            || !inside(b, bx + lo, by)
+        {
             return scores;
         }
         let len = self.side();
@@ -738,7 +746,7 @@ impl SearchLine<'_> {
             sb[..strip_len].copy_from_slice(row_b(r));
         }
         for (k, dx) in (lo..=hi).enumerate() {
-            if !valid(b, bx + dx, by) {
+            if !self.right_valid(bx + dx) {
                 continue;
             }
             let sb = col_b[k..k + len].iter().sum::<u32>() as f32;
@@ -799,8 +807,7 @@ impl SearchLine<'_> {
         vector_block(b, origin, [strip_width, side], &mut strip);
         let mut window = vec![0.0; CHANNELS * n];
         for (k, dx) in (lo..=hi).enumerate() {
-            let x = bx + dx;
-            if !b.window_valid(x - half..x + half + 1, by - half..by + half + 1) {
+            if !self.right_valid(bx + dx) {
                 continue;
             }
             for (channel, src) in window
