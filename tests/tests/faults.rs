@@ -146,7 +146,8 @@ fn soc_hung_firmware_is_ended_by_the_board_watchdog() {
         }
         other => panic!("{test}: not the watchdog's error: {other}"),
     }
-    // 400,000 simulated clocks at some 100,000 a second, and the board's start.
+    // The watchdog's 419,840 simulated clocks (twenty 640-pixel line times at the board's
+    // pixel clock) at some 100,000 a second, and the board's start.
     assert!(took < Duration::from_secs(60), "{test}: took {took:?}");
     eprintln!("{test}: {took:.1?}: {err}");
 }

@@ -27,7 +27,7 @@
 //   message. The default line blanking, 16 pixel clocks, is shorter than a real sensor's
 //   (VGA timing has 160, an MT9V034 at least 61): the fabric's work at a line's end must fit
 //   in it, so the shortest is the hardest case. A pixel clock is one clock in
-//   --pixel-clock-divider (default 64: the stream engine's pace, docs/STREAM_ENGINE.md; at 1
+//   --pixel-clock-divider (default 32: the stream engine's pace, docs/STREAM_ENGINE.md; at 1
 //   the engine falls behind and the frame stops with STREAM_FAULT.OVERRUN).
 // - The link: the UART's bytes and both LINK_OUT ports share the socket at link-frame
 //   boundaries: a source that has begun a frame keeps the socket until its 0x00 delimiter,
@@ -39,8 +39,9 @@
 // - --max-cycles (default: none) ends a run that did not finish with exit status 124 and a
 //   message naming the limit; the host reports the status and the message.
 // - The watchdog: a run in which nothing moves for --watchdog-cycles clocks (default
-//   400,000; 0 turns it off) ends with exit status 124 and a message saying what stood
-//   still and where the core last fetched. Moving is a camera pixel taken or a byte on the
+//   twenty line times of a 640-pixel line, at least 400,000: `default_watchdog`; 0 turns it
+//   off) ends with exit status 124 and a message saying what stood still and where the core
+//   last fetched. Moving is a camera pixel taken or a byte on the
 //   link either way; polling registers is not (a firmware stuck waiting for a camera that
 //   never sends polls STATUS forever). A healthy run's longest stillness is printed at exit
 //   (`longest_still`), well below the default (hdl-interface/soc/README.md).
@@ -61,12 +62,14 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -272,15 +275,28 @@ struct Camera {
 
 struct Args {
     std::string elf, uart, frames;
-    uint64_t divider = 64, line_blank = 16;
+    uint64_t divider = 32, line_blank = 16;
     std::vector<std::pair<std::string, uint32_t>> loads;
     uint64_t ram_mib = 128;
     uint64_t max_cycles = 0;
-    // About ten times the longest stillness of a healthy 640x240 or 640x480 pair (40,125
-    // clocks: the stream engine's end-of-frame passes; `stereocal hil --soc --width 640
-    // --height 480 --json`, sim_longest_still_clocks), a few seconds of simulation.
-    uint64_t watchdog = 400000;
+    // --watchdog-cycles; unset: `default_watchdog`.
+    std::optional<uint64_t> watchdog;
 };
+
+/// The widest line the board's fabrics take (sc_soc.v's sc_fabric instances).
+constexpr uint64_t MAX_LINE = 640;
+
+/// The watchdog's limit when --watchdog-cycles is not given: twenty line times of the widest
+/// line (its pixels and the blanking, in pixel clocks of `divider` clocks), and never below
+/// 400,000 clocks. A healthy run's longest stillness is at most about one line time: in the
+/// flush after an image's last line no pixel goes in, and the stream engine has nothing to
+/// send until the line time ends (640x480: 20,300 clocks at one pixel clock in 32, 40,125 at
+/// one in 64; `stereocal hil --soc --width 640 --height 480 --json`,
+/// sim_longest_still_clocks). The floor keeps room for the stillness counted in clocks, not
+/// pixel clocks (the engine's end-of-frame passes), the larger part at a fast pixel clock.
+uint64_t default_watchdog(uint64_t divider, uint64_t line_blank) {
+    return std::max<uint64_t>(400000, 20 * (MAX_LINE + line_blank) * divider);
+}
 
 Args parse(int argc, char **argv) {
     Args a;
@@ -321,6 +337,7 @@ Args parse(int argc, char **argv) {
         }
     }
     if (a.elf.empty() || a.uart.empty()) die("usage: sc_soc_sim --elf ELF --uart SOCKET ...");
+    if (!a.watchdog.has_value()) a.watchdog = default_watchdog(a.divider, a.line_blank);
     return a;
 }
 
@@ -389,7 +406,7 @@ extern "C" int sc_soc_sim_main(int argc, char **argv) {
     while (exit_status < 0) {
         uint64_t still = cycle - last_move;
         if (still > longest_still) longest_still = still;
-        if (args.watchdog && still >= args.watchdog) {
+        if (*args.watchdog && still >= *args.watchdog) {
             std::fprintf(stderr, "sc_soc_sim: watchdog: nothing moved for %llu clocks (no "
                          "camera pixel taken, no byte on the link either way) since clock "
                          "%llu; the core last fetched at 0x%08x: the firmware hangs\n",

@@ -50,14 +50,14 @@ pub struct HilArgs {
     /// stereocal-hil --bin sc-soc-sim`).
     #[arg(long, value_name = "SC_SOC_SIM", num_args = 0..=1)]
     soc: Option<Option<PathBuf>>,
-    /// On the SoC: the cameras' pixel clock, one clock in N (the board's default is 64, the
+    /// On the SoC: the cameras' pixel clock, one clock in N (the board's default is 32, the
     /// stream engine's pace; 1 is a pixel every clock).
     #[arg(long, requires = "soc", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pixel_clock_divider: Option<u32>,
     /// Seconds to wait for one answer or frame pair (default: 120 under QEMU, where a run
     /// whose link is silent for 10 s ends as hung; 3600 on the SoC, where a 640x480 pair is
-    /// minutes of simulation and the board itself ends a firmware that hangs after 400,000
-    /// clocks in which nothing moved).
+    /// minutes of simulation and the board itself ends a firmware that hangs after twenty
+    /// line times in which nothing moved).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=86_400))]
     timeout: Option<u64>,
     /// Count instructions (QEMU: with `-icount shift=0`; the SoC's core counts them itself)

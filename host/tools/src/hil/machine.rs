@@ -82,7 +82,7 @@ impl Default for MachineTimeouts {
 impl MachineTimeouts {
     /// The SoC in the loop's: an hour for an answer and for silence. A 640x480 pair is
     /// minutes of simulation there, and the board itself ends a firmware that hangs (its
-    /// watchdog, after 400,000 clocks in which nothing moved), so the host's own limits
+    /// watchdog, after twenty line times in which nothing moved), so the host's own limits
     /// only catch a simulator that stopped.
     pub fn soc() -> Self {
         Self {
@@ -112,7 +112,7 @@ pub struct MachineConfig {
     /// `-icount`.
     pub soc: Option<PathBuf>,
     /// On the SoC: the cameras' pixel clock, one clock in this many; `None` keeps the board's
-    /// default (64, the stream engine's pace).
+    /// default (32, the stream engine's pace).
     pub pixel_clock_divider: Option<u32>,
     /// The timeouts.
     pub timeouts: MachineTimeouts,
