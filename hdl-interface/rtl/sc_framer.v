@@ -60,9 +60,7 @@ module sc_framer #(
                      S_FIRST = 4'd8;    // reading the first code
 
     reg  [3:0]    state;
-    reg  [7:0]    mem [0:MAXLEN-1];
     reg  [AW-1:0] n;                    // bytes stored (packet, then packet and CRC)
-    reg  [7:0]    cm [0:MAXLEN];        // block codes: at most one per byte, and the last
     reg  [AW-1:0] cn;                   // codes stored
     reg  [7:0]    run;                  // non-zero bytes of the block being stored, 0..253
     reg           full_end;             // the last byte stored ended a full block
@@ -78,7 +76,6 @@ module sc_framer #(
     // RS shift register: rs[0] the highest degree; the block's bytes so far.
     reg  [7:0]    rs [0:15];
     reg  [7:0]    in_block;             // 0..239
-    reg  [127:0]  par [0:BLOCKS-1];     // a block's parity bytes, byte r at bits 8r..8r+7
     reg  [PW-1:0] par_n;                // parity bytes stored (16 per row)
     reg  [PW-1:0] par_at;               // parity bytes packed
     reg  [14:0]   bits;                 // packer: bits held, right-aligned
@@ -128,25 +125,24 @@ module sc_framer #(
     wire          we = !rst && (state == S_IN && in_valid || state == S_CRC);
     wire [7:0]    wd = state == S_IN ? in_data : ~crc[8*crc_at +: 8];
     reg  [AW-1:0] ra;
-    reg  [7:0]    q;
-    always @(posedge clk) begin
-        if (we) mem[n] <= wd;
-        q <= mem[ra];
-    end
+    wire [7:0]    q;
+    sc_ram #(.DW(8), .DEPTH(MAXLEN), .AW(AW)) packet (
+        .clk(clk), .we(we), .wa(n), .wd(wd), .re(1'b1), .ra(ra), .q(q)
+    );
 
     // The code memory: a code is written at `cn` by the byte that ends its block, or on
-    // S_LAST; `cq` is the code at `cra` presented on the clock before. S_FIRST reads the first
+    // S_LAST (at most one per byte, and the last); `cq` is the code at `cra` presented on the
+    // clock before. S_FIRST reads the first
     // code on the clock after S_LAST's write, which may be that code.
     wire          ends_zero = we && wd == 8'd0;
     wire          ends_full = we && wd != 8'd0 && run == 8'd253;
     wire          cwe = ends_zero || ends_full || !rst && state == S_LAST && !full_end;
     wire [7:0]    cwd = ends_full ? 8'hFF : run + 8'd1;
     reg  [AW-1:0] cra;
-    reg  [7:0]    cq;
-    always @(posedge clk) begin
-        if (cwe) cm[cn] <= cwd;
-        cq <= cm[cra];
-    end
+    wire [7:0]    cq;
+    sc_ram #(.DW(8), .DEPTH(MAXLEN + 1), .AW(AW)) codes (
+        .clk(clk), .we(cwe), .wa(cn), .wd(cwd), .re(1'b1), .ra(cra), .q(cq)
+    );
 
     // ------------------------------------------------------------------------------------
     // What goes out now.
@@ -195,28 +191,22 @@ module sc_framer #(
     // stands). The packer reads the row of the byte it packs next: a byte loaded gives it at
     // least seven bits to send, so a clock always lies between two loads, and the row read
     // there is the next byte's. A row read on the clock it is written (the body's only block,
-    // at its end) comes from the written data.
+    // at its end) is the written row (write-first). Byte r of a row is at bits 8r..8r+7.
     wire          block_end = body_byte && protect && in_block == 8'd238;
     wire          par_we = !rst && (block_end || state == S_PARITY && protect && in_block != 8'd0);
     wire [PW-5:0] par_wa = par_n[PW-1:4];
     wire [PW-5:0] par_ra = state == S_PACK ? par_at[PW-1:4] : {(PW-4){1'b0}};
     reg  [127:0]  par_wd;
-    reg  [127:0]  par_q;
-    reg  [127:0]  par_wd_q;
-    reg           par_bypass;
+    wire [127:0]  par_row;
     integer       g;
     always @(*) begin
         for (g = 0; g < 15; g = g + 1)
             par_wd[8*g +: 8] = block_end ? rs[g + 1] ^ gf_mul(fb, gen(g)) : rs[g];
         par_wd[120 +: 8] = block_end ? gf_mul(fb, gen(15)) : rs[15];
     end
-    always @(posedge clk) begin
-        if (par_we) par[par_wa] <= par_wd;
-        par_q <= par[par_ra];
-        par_bypass <= par_we && par_wa == par_ra;
-        par_wd_q <= par_wd;
-    end
-    wire [127:0]  par_row = par_bypass ? par_wd_q : par_q;
+    sc_ram #(.DW(128), .DEPTH(BLOCKS), .WRITE_FIRST(1), .AW(PW - 4)) parity (
+        .clk(clk), .we(par_we), .wa(par_wa), .wd(par_wd), .re(1'b1), .ra(par_ra), .q(par_row)
+    );
 
     integer r;
     always @(posedge clk) begin

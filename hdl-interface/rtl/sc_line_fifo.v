@@ -3,9 +3,9 @@
 // the pop happens first, then the push (octave.rs): a pop frees its entry for the push of the
 // same clock, and a push into an empty FIFO is popped on a later clock only.
 //
-// Synchronous read: `pop_data` is a register holding mem[head] (loaded on every edge from the
-// next head, bypassing a value written to that entry on the same edge), so the memory maps to
-// block RAM. A pop from an empty FIFO and a push into a full one do nothing but raise
+// Synchronous read: `pop_data` is the memory's read register holding the entry at head (loaded
+// on every edge from the next head; write-first, so a value written to that entry on the same
+// edge is the one loaded), so the memory (sc_ram) maps to block RAM. A pop from an empty FIFO and a push into a full one do nothing but raise
 // `pop_err` / `push_err` (the model's align_errors; zero when the octave is right).
 //
 // Widths: DW-bit entries; head < DEPTH (AW bits), len <= DEPTH (LW bits).
@@ -31,10 +31,9 @@ module sc_line_fifo #(
     localparam [31:0] DEPTH32 = DEPTH;
     localparam [AW:0] CAP = DEPTH32[AW:0];
 
-    reg [DW-1:0] mem [0:DEPTH-1];  // power-up content never read
     reg [AW-1:0] head;             // < DEPTH
     reg [LW-1:0] len;              // <= DEPTH
-    reg [DW-1:0] rd;               // mem[head]
+    wire [DW-1:0] rd;              // the entry at head
 
     assign pop_ok = len != {LW{1'b0}};
     wire do_pop   = pop && pop_ok;
@@ -49,9 +48,11 @@ module sc_line_fifo #(
     wire [AW+1:0] tail  = {2'b00, head} + {{(AW+2-LW){1'b0}}, len};
     wire [AW-1:0] waddr = (tail >= {1'b0, CAP}) ? tail[AW-1:0] - CAP[AW-1:0] : tail[AW-1:0];
 
+    sc_ram #(.DW(DW), .DEPTH(DEPTH), .WRITE_FIRST(1), .AW(AW)) entries (
+        .clk(clk), .we(do_push), .wa(waddr), .wd(push_data), .re(1'b1), .ra(head_n), .q(rd)
+    );
+
     always @(posedge clk) begin
-        if (do_push) mem[waddr] <= push_data;
-        rd <= (do_push && waddr == head_n) ? push_data : mem[head_n];
         if (start) begin
             head <= {AW{1'b0}};
             len  <= {LW{1'b0}};

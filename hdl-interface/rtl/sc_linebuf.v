@@ -50,13 +50,11 @@ module sc_linebuf #(
     generate
         for (i = 0; i < N; i = i + 1) begin : g_slot
             localparam [SW-1:0] ID = i;
-            reg [DW-1:0] mem [0:W-1];  // power-up content never selected (borders clamp)
-            reg [DW-1:0] rd;
-            always @(posedge clk) begin
-                if (we && current == ID) mem[waddr] <= wdata;
-                if (start || en) rd <= mem[raddr];
-            end
-            assign q[i*DW +: DW] = rd;
+            // Power-up content is never selected (the borders clamp).
+            sc_ram #(.DW(DW), .DEPTH(W), .AW(AW)) line (
+                .clk(clk), .we(we && current == ID), .wa(waddr), .wd(wdata),
+                .re(start || en), .ra(raddr), .q(q[i*DW +: DW])
+            );
         end
         for (d = 1; d <= N; d = d + 1) begin : g_delay
             // slot (current - d) mod N = (current + N - d) mod N

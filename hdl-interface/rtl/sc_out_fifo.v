@@ -107,19 +107,16 @@ module sc_out_fifo #(
     genvar b;
     generate
         for (b = 0; b < 4; b = b + 1) begin : g_bank
-            reg  [DW-1:0] mem [0:ROWS-1];
-            reg  [DW-1:0] q;
             wire          we = hit[b] | hit[4 + b] | hit[8 + b] | hit[12 + b];
             wire [DW-1:0] wd = ({DW{hit[b]}}      & in_data[0*DW +: DW])
                              | ({DW{hit[4 + b]}}  & in_data[1*DW +: DW])
                              | ({DW{hit[8 + b]}}  & in_data[2*DW +: DW])
                              | ({DW{hit[12 + b]}} & in_data[3*DW +: DW]);
             wire [AW-1:0] wa = wrap[b] ? wrow_next : wrow;
-            always @(posedge clk) begin
-                if (we) mem[wa] <= wd;
-                q <= (we && wa == rrow_n) ? wd : mem[rrow_n];
-            end
-            assign q_all[b*DW +: DW] = q;
+            sc_ram #(.DW(DW), .DEPTH(ROWS), .WRITE_FIRST(1), .AW(AW)) bank (
+                .clk(clk), .we(we), .wa(wa), .wd(wd), .re(1'b1), .ra(rrow_n),
+                .q(q_all[b*DW +: DW])
+            );
         end
     endgenerate
     assign head = q_all[rlane*DW +: DW];

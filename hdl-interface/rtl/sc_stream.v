@@ -169,9 +169,8 @@ module sc_stream #(
     // Flush.
     reg [2:0]  fk;
 
-    // ---- memories (synchronous reads) ----
-    reg [13:0]  ring [0:RING-1];
-    reg [13:0]  ring_q;
+    // ---- memories (synchronous reads; the ring's ports are below) ----
+    wire [13:0] ring_q;
     reg [47:0]  stash [0:STASH-1];
     reg [47:0]  stash_q;
     reg [49:0]  queue [0:QUEUE-1];       // {index[15:0], octave[1:0], y[15:0], x[15:0]}
@@ -346,9 +345,11 @@ module sc_stream #(
             ring_ra = ring_addr(base[co], w[co], tx_row, tx_x + tx_e);
     end
 
+    sc_ram #(.DW(14), .DEPTH(RING), .AW(RA)) ring (
+        .clk(clk), .we(ring_we), .wa(ring_wa), .wd(ring_wd), .re(1'b1), .ra(ring_ra), .q(ring_q)
+    );
+
     always @(posedge clk) begin
-        if (ring_we) ring[ring_wa] <= ring_wd;
-        ring_q <= ring[ring_ra];
         stash_q <= stash[st_i[SA-1:0]];
         queue_q <= queue[q_r[QA-1:0]];
         batch_q <= batch[tx_e[6:0]];

@@ -214,6 +214,7 @@ fn rtl_framer_sends_the_rust_framers_bytes() {
         .args(["-g2005", "-Wall", "-s", "tb_framer", "-o"])
         .arg(&sim)
         .arg(rtl.join("sc_framer.v"))
+        .arg(rtl.join("sc_ram.v"))
         .arg(rtl.join("tb/tb_framer.v"))
         .output()
         .expect("iverilog runs");

@@ -7,6 +7,6 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 iverilog -g2005 -Wall -s tb_conv -o "$out/tb_conv.vvp" \
     "$here/../sc_row_conv.v" "$here/../sc_col_conv.v" "$here/../sc_linebuf.v" \
-    "$here/../sc_da_dot.v" "$here/tb_conv.v"
+    "$here/../sc_ram.v" "$here/../sc_da_dot.v" "$here/tb_conv.v"
 vvp -n "$out/tb_conv.vvp" | tee "$out/log"
 grep -q '^PASS tb_conv' "$out/log"
