@@ -10,6 +10,7 @@ use image::GrayImage;
 use stereocal::calib::Calibration;
 use stereocal::image_sequence::{load_gray, SizeLimits, StereoSequence};
 use stereocal_synth::injected::{write_injected, Motion, Source};
+use stereocal_synth::yaw_warp::Resampling;
 
 use crate::output::progress_bar;
 
@@ -24,6 +25,16 @@ pub enum MotionArg {
     Fixed,
     /// The verge swings ±10°, half of it on each camera.
     Swing,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ResampleArg {
+    /// Keys' cubic convolution, 4x4 taps.
+    Bicubic,
+    /// Lanczos of radius 3, 6x6 taps.
+    Lanczos3,
+    /// Lanczos of radius 5, 10x10 taps (the closest to band-limited, the slowest).
+    Lanczos5,
 }
 
 #[derive(Debug, Clone, Args)]
@@ -52,6 +63,11 @@ pub struct InjectArgs {
     /// Head motion.
     #[arg(long, value_enum, default_value_t = MotionArg::Moving)]
     motion: MotionArg,
+    /// The warp's interpolation kernel. No kernel is exact on real pixels, and each one draws
+    /// a frame's resampling error anew: `bench/drives.py --resample` shows how much of the
+    /// figures that is.
+    #[arg(long, value_enum, default_value_t = ResampleArg::Bicubic)]
+    resample: ResampleArg,
     /// Directory to create (must not exist or be empty): left/, right/, calib.toml, truth.csv.
     #[arg(long)]
     out: PathBuf,
@@ -85,6 +101,11 @@ pub fn inject(args: &InjectArgs) -> anyhow::Result<()> {
         MotionArg::Fixed => Motion::Fixed,
         MotionArg::Swing => Motion::Swing,
     };
+    let resampling = match args.resample {
+        ResampleArg::Bicubic => Resampling::Bicubic,
+        ResampleArg::Lanczos3 => Resampling::Lanczos3,
+        ResampleArg::Lanczos5 => Resampling::Lanczos5,
+    };
     // clap lets through one complete form: both images, or both directories.
     let input = match (&args.left_image, &args.right_image, &args.left, &args.right) {
         (Some(l), Some(r), _, _) => Input::Pair(image(l)?, image(r)?),
@@ -107,7 +128,15 @@ pub fn inject(args: &InjectArgs) -> anyhow::Result<()> {
         ),
     };
     let bar = progress_bar(frames as u64, "warping");
-    write_injected(&args.out, source, &calib, motion, frames, &|_| bar.inc(1))?;
+    write_injected(
+        &args.out,
+        source,
+        &calib,
+        motion,
+        frames,
+        resampling,
+        &|_| bar.inc(1),
+    )?;
     bar.finish_and_clear();
     eprintln!(
         "wrote {frames} injected frame pairs, calib.toml and truth.csv to {}",

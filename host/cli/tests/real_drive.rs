@@ -90,3 +90,40 @@ fn a_held_head_on_a_real_drive_keeps_its_filtered_span() {
         .expect("filtered span");
     assert!(span <= SPAN_LIMIT_DEG, "filtered span {span:.4}°");
 }
+
+/// `inject --resample` warps the same frames with another kernel: the same truth and
+/// calibration, other pixels.
+#[test]
+fn inject_resamples_with_the_kernel_it_is_given() {
+    let Some(kitti) = kitti() else { return };
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let inject = |kernel: &str| {
+        let out = tmp.path().join(kernel);
+        let mut args: Vec<OsString> = vec!["inject".into()];
+        for (flag, name) in [("left-image", "left"), ("right-image", "right")] {
+            let mut arg = OsString::from(format!("--{flag}="));
+            arg.push(kitti.join(name).join("000000.png"));
+            args.push(arg);
+        }
+        let mut calib = OsString::from("--calib=");
+        calib.push(kitti.join("calib.toml"));
+        args.push(calib);
+        args.extend(["--frames", "2", "--resample", kernel, "--out"].map(OsString::from));
+        args.push(out.clone().into());
+        succeeded(stereocal(&args));
+        let read = |name: &str| std::fs::read(out.join(name)).expect(name);
+        let frames: Vec<Vec<u8>> = [
+            "left/000000.png",
+            "left/000001.png",
+            "right/000000.png",
+            "right/000001.png",
+        ]
+        .map(read)
+        .into();
+        (read("truth.csv"), read("calib.toml"), frames)
+    };
+    let (bicubic, lanczos) = (inject("bicubic"), inject("lanczos5"));
+    assert_eq!(bicubic.0, lanczos.0, "truth.csv");
+    assert_eq!(bicubic.1, lanczos.1, "calib.toml");
+    assert_ne!(bicubic.2, lanczos.2, "the warped frames");
+}

@@ -22,7 +22,7 @@ use std::path::Path;
 use image::GrayImage;
 use rayon::prelude::*;
 
-use crate::yaw_warp::YawWarp;
+use crate::yaw_warp::{Resampling, YawWarp};
 use crate::SynthError;
 use stereocal::calib::{Calibration, CameraIntrinsics};
 use stereocal::image_sequence::{GrayFrame, StereoSequence};
@@ -184,7 +184,7 @@ fn cropped_camera(camera: &CameraIntrinsics, window: Window) -> CameraIntrinsics
 }
 
 /// Writes `frames` injected pairs of `source` into `dir` (which must not exist or be
-/// empty), cropped to the [`common_window`] of the sequence, with `calib.toml` (principal
+/// empty), warped with `resampling`, cropped to the [`common_window`] of the sequence, with `calib.toml` (principal
 /// points moved with the crop) and `truth.csv`. Everything is written to a sibling
 /// [`StagingDir`] first and renamed into place, so neither a failure nor Ctrl-C leaves
 /// anything half-written.
@@ -194,6 +194,7 @@ pub fn write_injected(
     calib: &Calibration,
     motion: Motion,
     frames: usize,
+    resampling: Resampling,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<(), SynthError> {
     let io = |path: &Path| {
@@ -258,7 +259,7 @@ pub fn write_injected(
             (&rdir, &right, &calib.right, ar),
         ] {
             let path = d.join(&name);
-            let warped = YawWarp::new(cam, alpha).apply(img);
+            let warped = YawWarp::new(cam, alpha).apply_with(img, resampling);
             image::imageops::crop_imm(&warped, window.x, window.y, window.width, window.height)
                 .to_image()
                 .save(&path)
@@ -305,7 +306,16 @@ mod tests {
             left: &img,
             right: &img,
         };
-        write_injected(&dir, pair, &calib, Motion::Moving, 4, &|_| {}).unwrap();
+        write_injected(
+            &dir,
+            pair,
+            &calib,
+            Motion::Moving,
+            4,
+            Resampling::Bicubic,
+            &|_| {},
+        )
+        .unwrap();
         assert_eq!(fs::read_dir(dir.join("left")).unwrap().count(), 4);
         assert_eq!(fs::read_dir(dir.join("right")).unwrap().count(), 4);
         let truth = stereocal::output::verge_csv::read_truth_csv(&dir.join("truth.csv")).unwrap();
@@ -319,7 +329,15 @@ mod tests {
         // Only the finished directory is left beside it.
         assert_eq!(fs::read_dir(tmp.path()).unwrap().count(), 1);
         // A second run into the now non-empty directory is refused.
-        let again = write_injected(&dir, pair, &calib, Motion::Fixed, 2, &|_| {});
+        let again = write_injected(
+            &dir,
+            pair,
+            &calib,
+            Motion::Fixed,
+            2,
+            Resampling::Bicubic,
+            &|_| {},
+        );
         assert!(matches!(again, Err(SynthError::OutputNotEmpty(_))));
     }
 
@@ -356,7 +374,16 @@ mod tests {
         };
         let dir = tmp.path().join("set");
         let source = Source::Sequence(&seq);
-        write_injected(&dir, source, &calib, Motion::Swing, 3, &|_| {}).unwrap();
+        write_injected(
+            &dir,
+            source,
+            &calib,
+            Motion::Swing,
+            3,
+            Resampling::Bicubic,
+            &|_| {},
+        )
+        .unwrap();
         let truth = stereocal::output::verge_csv::read_truth_csv(&dir.join("truth.csv")).unwrap();
         assert_eq!(truth.len(), 3);
         for (i, t) in truth.iter().enumerate() {
@@ -391,6 +418,7 @@ mod tests {
             &calib,
             Motion::Fixed,
             4,
+            Resampling::Bicubic,
             &|_| {},
         );
         assert!(matches!(
