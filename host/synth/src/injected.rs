@@ -184,10 +184,10 @@ fn cropped_camera(camera: &CameraIntrinsics, window: Window) -> CameraIntrinsics
 }
 
 /// Writes `frames` injected pairs of `source` into `dir` (which must not exist or be
-/// empty), warped with `resampling`, cropped to the [`common_window`] of the sequence, with `calib.toml` (principal
-/// points moved with the crop) and `truth.csv`. Everything is written to a sibling
-/// [`StagingDir`] first and renamed into place, so neither a failure nor Ctrl-C leaves
-/// anything half-written.
+/// empty), warped with `resampling` and cropped to the [`common_window`] of the sequence,
+/// with `calib.toml` (principal points moved with the crop) and `truth.csv`. Everything is
+/// written to a sibling [`StagingDir`] first and renamed into place, so neither a failure nor
+/// Ctrl-C leaves anything half-written.
 pub fn write_injected(
     dir: &Path,
     source: Source<'_>,
