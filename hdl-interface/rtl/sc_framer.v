@@ -132,8 +132,8 @@ module sc_framer #(
 
     // The code memory: a code is written at `cn` by the byte that ends its block, or on
     // S_LAST (at most one per byte, and the last); `cq` is the code at `cra` presented on the
-    // clock before. S_FIRST reads the first
-    // code on the clock after S_LAST's write, which may be that code.
+    // clock before. S_FIRST reads the first code on the clock after S_LAST's write, which may
+    // be that code.
     wire          ends_zero = we && wd == 8'd0;
     wire          ends_full = we && wd != 8'd0 && run == 8'd253;
     wire          cwe = ends_zero || ends_full || !rst && state == S_LAST && !full_end;
