@@ -2,7 +2,7 @@
 //! through the commands a user types: a head held at 1.5° while it turns ±1° (`stereocal
 //! inject --motion fixed`) on a drive whose view changes every frame. Every frame must be
 //! estimated, and the filtered verge must hold within issue 21's 0.05° span at the drive's
-//! 10 fps (README, "Accuracy on real drives": 0.024°), helped by the filter learning how far
+//! 10 fps (README, "Accuracy on real drives": 0.034°), helped by the filter learning how far
 //! off the view puts its measurements (`host/src/kalman.rs`).
 
 mod common;
