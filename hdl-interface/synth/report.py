@@ -374,7 +374,10 @@ def main():
       "yosys marks it experimental. Resource counts only, octave only (it alone already exceeds "
       "the thesis' device, and it is the slowest step).")
     A("- `synth_ice40 -dsp` (iCE40 UltraPlus primitives: LUT4, SB_RAM40_4K, SB_MAC16), "
-      "`-noflatten` so the module is its own hierarchy level, then `nextpnr-ice40` on the "
+      "`-noflatten` so the module is its own hierarchy level (logic that a flattened synthesis "
+      "would share between instances is counted in each: the line memories of one "
+      "`sc_linebuf` are one `sc_ram` each and read one address, and each keeps its own "
+      "registers for its block-RAM cascade), then `nextpnr-ice40` on the "
       "**iCE40UP5K** (the iCE40 with DSPs, package sg48) and, for blocks without DSP use or "
       "resynthesised without `-dsp`, the **iCE40HX8K** (the largest iCE40 nextpnr supports: "
       "7,680 logic cells, 32 block RAMs; ct256). Fixed seed 1, target "
