@@ -196,13 +196,14 @@ module sc_framer #(
     wire          par_we = !rst && (block_end || state == S_PARITY && protect && in_block != 8'd0);
     wire [PW-5:0] par_wa = par_n[PW-1:4];
     wire [PW-5:0] par_ra = state == S_PACK ? par_at[PW-1:4] : {(PW-4){1'b0}};
+    reg  [127:0]  rs_next;              // the shift register after the body byte going out
     reg  [127:0]  par_wd;
     wire [127:0]  par_row;
     integer       g;
     always @(*) begin
-        for (g = 0; g < 15; g = g + 1)
-            par_wd[8*g +: 8] = block_end ? rs[g + 1] ^ gf_mul(fb, gen(g)) : rs[g];
-        par_wd[120 +: 8] = block_end ? gf_mul(fb, gen(15)) : rs[15];
+        for (g = 0; g < 15; g = g + 1) rs_next[8*g +: 8] = rs[g + 1] ^ gf_mul(fb, gen(g));
+        rs_next[120 +: 8] = gf_mul(fb, gen(15));
+        for (g = 0; g < 16; g = g + 1) par_wd[8*g +: 8] = block_end ? rs_next[8*g +: 8] : rs[g];
     end
     sc_ram #(.DW(128), .DEPTH(BLOCKS), .WRITE_FIRST(1), .AW(PW - 4)) parity (
         .clk(clk), .we(par_we), .wa(par_wa), .wd(par_wd), .re(1'b1), .ra(par_ra), .q(par_row)
@@ -303,8 +304,7 @@ module sc_framer #(
                     in_block <= 8'd0;
                     for (r = 0; r < 16; r = r + 1) rs[r] <= 8'd0;
                 end else begin
-                    for (r = 0; r < 15; r = r + 1) rs[r] <= rs[r + 1] ^ gf_mul(fb, gen(r));
-                    rs[15] <= gf_mul(fb, gen(15));
+                    for (r = 0; r < 16; r = r + 1) rs[r] <= rs_next[8*r +: 8];
                     in_block <= in_block + 8'd1;
                 end
             end
