@@ -36,6 +36,9 @@ pub enum MisalignmentArg {
     WindowTilt,
     /// As `window`, the roll alone: the pitch held at the calibration's (the default).
     WindowRoll,
+    /// As `window-roll`, and each frame's own pitch, held to the frames' mean by their
+    /// learned spread.
+    WindowFramePitch,
 }
 
 /// What the fabric streams besides the points (`--sobel`).
@@ -151,6 +154,7 @@ impl EstimateArgs {
                 ..WindowConfig::default()
             }),
             MisalignmentArg::WindowRoll => Some(WindowConfig::roll()),
+            MisalignmentArg::WindowFramePitch => Some(WindowConfig::roll_and_frame_pitch()),
         };
         config.sobel_output = match self.sobel {
             SobelArg::Rows => SobelOutput::Rows,

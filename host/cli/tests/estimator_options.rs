@@ -80,7 +80,7 @@ impl Effect {
 #[test]
 fn every_optional_mode_estimates_the_verge() {
     let default = eval(&[]);
-    let modes: [(&[&str], Effect, f64); 16] = [
+    let modes: [(&[&str], Effect, f64); 17] = [
         (&["--descriptor", "reduced16"], Effect::OtherMatches, 0.05),
         (&["--rotate"], Effect::OtherMatches, 0.05),
         (&["--no-cross-check"], Effect::OtherMatches, 0.05),
@@ -101,6 +101,13 @@ fn every_optional_mode_estimates_the_verge() {
         (
             &["--misalignment", "window-tilt"],
             Effect::SameMatchesOtherEstimates,
+            0.05,
+        ),
+        // The rendered head's frames do not pitch apart: the prior holds each frame's own
+        // pitch at their mean, and the estimates are the default's to the bit.
+        (
+            &["--misalignment", "window-frame-pitch"],
+            Effect::SameEstimatesWireBytesAtLeast(1.0),
             0.05,
         ),
         // The default learns the roll over a window; `off` takes each frame alone.

@@ -10,7 +10,7 @@
 //! `E = R_rᵀ [t]ₓ Ry(a_l)` with `x_rᵀ E x_l = 0`. With the three misalignments zero it is the
 //! thesis' model ([`super::constrained`]).
 
-use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use super::constrained::{VergeAngles, YAW_MIN_MATCHES};
 use super::{mad_sigma, rot_x, rot_y, rot_z, skew, Correspondence, EssentialError, RefineConfig};
@@ -142,6 +142,83 @@ pub fn refine_yaws(
     m: &Misalignment,
     config: &RefineConfig,
 ) -> Result<YawFit, EssentialError> {
+    let fit = refine_frame::<2>(matches, init, m, None, config)?;
+    let cov = fit
+        .information
+        .try_inverse()
+        .ok_or(EssentialError::Degenerate)?
+        * fit.sigma
+        * fit.sigma;
+    let verge_var = cov[(0, 0)] + cov[(1, 1)] - 2.0 * cov[(0, 1)];
+    Ok(YawFit {
+        angles: fit.angles,
+        verge_sigma: verge_var.max(0.0).sqrt(),
+        residual_sigma: fit.sigma,
+    })
+}
+
+/// Where a frame's own pitch is held when it is refined with its yaws: a normal prior of
+/// this centre and variance (radians, radians²).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PitchPrior {
+    /// The pitch the frames share.
+    pub centre: f64,
+    /// How far the frames' pitches spread about it, as a variance.
+    pub variance: f64,
+}
+
+/// One frame's yaws and its own pitch refined with the roll and tilt held.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PitchFit {
+    /// The refined yaws of both cameras.
+    pub angles: VergeAngles,
+    /// The frame's pitch (radians).
+    pub pitch: f64,
+    /// Its variance from the Gauss-Newton covariance (radians²), the prior's part included.
+    pub pitch_variance: f64,
+}
+
+/// Robust Gauss-Newton refinement of one frame's yaws and its own pitch from `init` and
+/// `m`'s pitch, with `m`'s roll and tilt held and, when given, `prior` on the pitch.
+pub fn refine_yaws_and_pitch(
+    matches: &[Correspondence],
+    init: VergeAngles,
+    m: &Misalignment,
+    prior: Option<PitchPrior>,
+    config: &RefineConfig,
+) -> Result<PitchFit, EssentialError> {
+    let fit = refine_frame::<3>(matches, init, m, prior, config)?;
+    let cov = fit
+        .information
+        .try_inverse()
+        .ok_or(EssentialError::Degenerate)?
+        * fit.sigma
+        * fit.sigma;
+    Ok(PitchFit {
+        angles: fit.angles,
+        pitch: fit.pitch,
+        pitch_variance: cov[(2, 2)].max(0.0),
+    })
+}
+
+/// A frame's refinement: its yaws, its pitch, the information matrix of the `K` refined
+/// parameters in units of the residuals' robust scale, and that scale.
+struct FrameFit<const K: usize> {
+    angles: VergeAngles,
+    pitch: f64,
+    information: SMatrix<f64, K, K>,
+    sigma: f64,
+}
+
+/// Robust Gauss-Newton (IRLS) over the first `K` of `(alpha_l, alpha_r, pitch)`, the rest of
+/// `m` held; `prior` adds its normal term on the pitch when the pitch is refined (`K` = 3).
+fn refine_frame<const K: usize>(
+    matches: &[Correspondence],
+    init: VergeAngles,
+    m: &Misalignment,
+    prior: Option<PitchPrior>,
+    config: &RefineConfig,
+) -> Result<FrameFit<K>, EssentialError> {
     if matches.len() < YAW_MIN_MATCHES {
         return Err(EssentialError::TooFewMatches {
             got: matches.len(),
@@ -149,26 +226,34 @@ pub fn refine_yaws(
         });
     }
     let mut angles = init;
+    let mut m = *m;
     let mut residuals = vec![0.0; matches.len()];
-    let mut jac = vec![Vector2::zeros(); matches.len()];
+    let mut jac = vec![SVector::<f64, K>::zeros(); matches.len()];
     let mut sigma = config.min_sigma;
-    let mut info = Matrix2::zeros();
+    let mut info = SMatrix::<f64, K, K>::zeros();
     for _ in 0..config.max_iterations.max(1) {
-        let (e, de) = essential_and_derivatives(angles, m);
-        let de = [de[0], de[1]];
+        let (e, de_all) = essential_and_derivatives(angles, &m);
+        let de: [Matrix3<f64>; K] = std::array::from_fn(|i| de_all[i]);
         for (i, c) in matches.iter().enumerate() {
-            let (r, g) = residual_and_gradient(&e, &de, c).unwrap_or_default();
+            let (r, g) = residual_and_gradient(&e, &de, c).unwrap_or((0.0, [0.0; K]));
             let s = c.weight.sqrt();
             residuals[i] = r * s;
-            jac[i] = Vector2::new(g[0], g[1]) * s;
+            jac[i] = SVector::<f64, K>::from(g) * s;
         }
         sigma = mad_sigma(&residuals, config.min_sigma);
-        let mut h = Matrix2::zeros();
-        let mut b = Vector2::zeros();
+        let mut h = SMatrix::<f64, K, K>::zeros();
+        let mut b = SVector::<f64, K>::zeros();
         for (r, g) in residuals.iter().zip(&jac) {
             let w = config.loss.weight(*r, sigma);
             h += w * g * g.transpose();
             b += w * g * *r;
+        }
+        if let (Some(p), true) = (prior, K == 3) {
+            // The prior's cost (pitch - centre)² / variance, in the units of `h`, whose
+            // inverse times σ² is the covariance.
+            let lambda = sigma * sigma / p.variance;
+            h[(2, 2)] += lambda;
+            b[2] += lambda * (m.pitch - p.centre);
         }
         info = h;
         let step = h
@@ -177,7 +262,10 @@ pub fn refine_yaws(
             .ok_or(EssentialError::Degenerate)?;
         angles.alpha_l += step[0];
         angles.alpha_r += step[1];
-        if !(angles.alpha_l.is_finite() && angles.alpha_r.is_finite()) {
+        if K == 3 {
+            m.pitch += step[2];
+        }
+        if !(angles.alpha_l.is_finite() && angles.alpha_r.is_finite() && m.pitch.is_finite()) {
             return Err(EssentialError::Degenerate);
         }
         // 1e-10 rad is 6e-9°, as in the constrained refinement.
@@ -185,12 +273,11 @@ pub fn refine_yaws(
             break;
         }
     }
-    let cov = info.try_inverse().ok_or(EssentialError::Degenerate)? * sigma * sigma;
-    let verge_var = cov[(0, 0)] + cov[(1, 1)] - 2.0 * cov[(0, 1)];
-    Ok(YawFit {
+    Ok(FrameFit {
         angles,
-        verge_sigma: verge_var.max(0.0).sqrt(),
-        residual_sigma: sigma,
+        pitch: m.pitch,
+        information: info,
+        sigma,
     })
 }
 

@@ -182,6 +182,7 @@ mod tests {
                     pitch_sigma_deg: 0.001,
                     roll_sigma_deg: 0.002,
                     baseline_tilt_sigma_deg: 0.0,
+                    pitch_spread_deg: 0.0,
                     frames: 1,
                 }),
                 link_loss: None,
