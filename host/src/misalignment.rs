@@ -470,6 +470,25 @@ mod tests {
     use crate::essential::constrained;
     use crate::essential::testutil::misaligned_synthetic;
 
+    /// Frame `k`'s view: 1200 matches of a head at yaws `a` misaligned by `truth` (noise
+    /// `noise_px` at focal length `f`, drawn with `seed`), of which it sees half of the field,
+    /// a different half every frame, so that the per-frame model's error depends on where
+    /// the matches lie.
+    fn half_view(
+        a: VergeAngles,
+        truth: &Misalignment,
+        noise_px: f64,
+        f: f64,
+        seed: u64,
+        k: u64,
+    ) -> Vec<Correspondence> {
+        let side = [1.0, -1.0][k as usize % 2];
+        misaligned_synthetic(a, truth, 1200, noise_px, f, seed)
+            .into_iter()
+            .filter(|c| c.left[(k as usize / 2) % 2] * side > 0.0)
+            .collect()
+    }
+
     /// A head with a fixed pitch and roll, its verge moving, the view new every frame (new
     /// points, and each frame sees only part of the field: the per-frame model's error
     /// depends on where the matches lie). The window recovers the pitch and roll, and its
@@ -492,13 +511,7 @@ mod tests {
                 (1.0 + 0.5 * t.sin()).to_radians(),
                 (-0.5 + 0.4 * (0.7 * t).cos()).to_radians(),
             );
-            // Half of the field, a different half every frame.
-            let side = [1.0, -1.0][k as usize % 2];
-            let m: Vec<Correspondence> =
-                misaligned_synthetic(a, &truth, 1200, noise_px, f, 100 + k)
-                    .into_iter()
-                    .filter(|c| c.left[(k as usize / 2) % 2] * side > 0.0)
-                    .collect();
+            let m = half_view(a, &truth, noise_px, f, 100 + k, k);
             let plain = constrained::refine(&m, a, &refine).unwrap();
             let corrected = window.update(m, plain.angles).unwrap();
             if k >= 10 {
@@ -595,12 +608,7 @@ mod tests {
                 (1.0 + 0.5 * (0.4 * k as f64).sin()).to_radians(),
                 -0.5f64.to_radians(),
             );
-            let side = [1.0, -1.0][k as usize % 2];
-            let m: Vec<Correspondence> =
-                misaligned_synthetic(a, &truth, 1200, 0.15, 700.0, 700 + k)
-                    .into_iter()
-                    .filter(|c| c.left[(k as usize / 2) % 2] * side > 0.0)
-                    .collect();
+            let m = half_view(a, &truth, 0.15, 700.0, 700 + k, k);
             let plain = constrained::refine(&m, a, &refine).unwrap();
             let corrected = window.update(m, plain.angles).unwrap();
             if k >= 10 {

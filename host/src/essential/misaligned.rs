@@ -143,12 +143,7 @@ pub fn refine_yaws(
     config: &RefineConfig,
 ) -> Result<YawFit, EssentialError> {
     let fit = refine_frame::<2>(matches, init, m, None, config)?;
-    let cov = fit
-        .information
-        .try_inverse()
-        .ok_or(EssentialError::Degenerate)?
-        * fit.sigma
-        * fit.sigma;
+    let cov = fit.covariance()?;
     let verge_var = cov[(0, 0)] + cov[(1, 1)] - 2.0 * cov[(0, 1)];
     Ok(YawFit {
         angles: fit.angles,
@@ -188,12 +183,7 @@ pub fn refine_yaws_and_pitch(
     config: &RefineConfig,
 ) -> Result<PitchFit, EssentialError> {
     let fit = refine_frame::<3>(matches, init, m, prior, config)?;
-    let cov = fit
-        .information
-        .try_inverse()
-        .ok_or(EssentialError::Degenerate)?
-        * fit.sigma
-        * fit.sigma;
+    let cov = fit.covariance()?;
     Ok(PitchFit {
         angles: fit.angles,
         pitch: fit.pitch,
@@ -208,6 +198,17 @@ struct FrameFit<const K: usize> {
     pitch: f64,
     information: SMatrix<f64, K, K>,
     sigma: f64,
+}
+
+impl<const K: usize> FrameFit<K> {
+    /// The refined parameters' covariance (radians²).
+    fn covariance(&self) -> Result<SMatrix<f64, K, K>, EssentialError> {
+        let inv = self
+            .information
+            .try_inverse()
+            .ok_or(EssentialError::Degenerate)?;
+        Ok(inv * self.sigma * self.sigma)
+    }
 }
 
 /// Robust Gauss-Newton (IRLS) over the first `K` of `(alpha_l, alpha_r, pitch)`, the rest of
