@@ -158,7 +158,8 @@ pub fn refine_yaws(
 pub struct PitchPrior {
     /// The pitch the frames share.
     pub centre: f64,
-    /// How far the frames' pitches spread about it, as a variance.
+    /// How far the frames' pitches spread about it, as a variance; positive (a prior of no
+    /// variance leaves the refinement [`EssentialError::Degenerate`]).
     pub variance: f64,
 }
 
@@ -378,5 +379,48 @@ mod tests {
             (held.angles.verge() - a.verge()).to_degrees().abs(),
         );
         assert!(eh < 0.01 && eh < 0.2 * ep, "held {eh}° vs plain {ep}°");
+    }
+
+    /// With the pitch free the refit finds the frame's own pitch and its verge from the roll
+    /// alone; a prior pulls the pitch towards its centre as far as its variance lets it, and
+    /// a prior of no variance is refused.
+    #[test]
+    fn a_frame_s_own_pitch_is_refined_with_its_yaws() {
+        let a = VergeAngles::new(1.0f64.to_radians(), -0.5f64.to_radians());
+        let m = Misalignment {
+            pitch: 0.3f64.to_radians(),
+            roll: 0.2f64.to_radians(),
+            tilt: 0.0,
+        };
+        let c = misaligned_matches(a, &m, 500, 0.1, 700.0, 5);
+        let cfg = RefineConfig::default();
+        let start = constrained::refine(&c, a, &cfg).unwrap().angles;
+        let roll_only = Misalignment { pitch: 0.0, ..m };
+        let free = refine_yaws_and_pitch(&c, start, &roll_only, None, &cfg).unwrap();
+        assert!((free.pitch.to_degrees() - 0.3).abs() < 0.01, "{free:?}");
+        assert!(
+            (free.angles.verge() - a.verge()).to_degrees().abs() < 0.01,
+            "{free:?}"
+        );
+        // A prior four of the fit's σ away.
+        let sd = free.pitch_variance.sqrt();
+        let centre = free.pitch - 4.0 * sd;
+        let held = |variance: f64| {
+            let prior = PitchPrior { centre, variance };
+            refine_yaws_and_pitch(&c, start, &roll_only, Some(prior), &cfg)
+        };
+        // As sure as the fit, it meets it half way.
+        let half = held(free.pitch_variance).unwrap();
+        assert!(
+            ((free.pitch - half.pitch) / sd - 2.0).abs() < 0.3,
+            "{half:?}, σ {sd}"
+        );
+        // Far surer than the fit, it holds the pitch at its centre.
+        let pinned = held(1e-6 * free.pitch_variance).unwrap();
+        assert!(
+            (pinned.pitch - centre).abs() < 0.01 * sd,
+            "{pinned:?}, σ {sd}"
+        );
+        assert!(matches!(held(0.0), Err(EssentialError::Degenerate)));
     }
 }
