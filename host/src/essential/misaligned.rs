@@ -360,17 +360,23 @@ mod tests {
         }
     }
 
-    /// With the true misalignment held, the yaw refit recovers the verge the thesis' model
-    /// bends by the pitch and roll.
-    #[test]
-    fn held_misalignment_unbends_the_verge() {
+    /// A head at yaws 1° and -0.5° whose right camera pitches by 0.3° and rolls by 0.2°, and
+    /// 500 of its matches (0.1 px noise at f = 700 px).
+    fn pitched_and_rolled() -> (VergeAngles, Misalignment, Vec<Correspondence>) {
         let a = VergeAngles::new(1.0f64.to_radians(), -0.5f64.to_radians());
         let m = Misalignment {
             pitch: 0.3f64.to_radians(),
             roll: 0.2f64.to_radians(),
             tilt: 0.0,
         };
-        let c = misaligned_matches(a, &m, 500, 0.1, 700.0, 5);
+        (a, m, misaligned_matches(a, &m, 500, 0.1, 700.0, 5))
+    }
+
+    /// With the true misalignment held, the yaw refit recovers the verge the thesis' model
+    /// bends by the pitch and roll.
+    #[test]
+    fn held_misalignment_unbends_the_verge() {
+        let (a, m, c) = pitched_and_rolled();
         let cfg = RefineConfig::default();
         let plain = constrained::refine(&c, a, &cfg).unwrap();
         let held = refine_yaws(&c, plain.angles, &m, &cfg).unwrap();
@@ -386,13 +392,7 @@ mod tests {
     /// a prior of no variance is refused.
     #[test]
     fn a_frame_s_own_pitch_is_refined_with_its_yaws() {
-        let a = VergeAngles::new(1.0f64.to_radians(), -0.5f64.to_radians());
-        let m = Misalignment {
-            pitch: 0.3f64.to_radians(),
-            roll: 0.2f64.to_radians(),
-            tilt: 0.0,
-        };
-        let c = misaligned_matches(a, &m, 500, 0.1, 700.0, 5);
+        let (a, m, c) = pitched_and_rolled();
         let cfg = RefineConfig::default();
         let start = constrained::refine(&c, a, &cfg).unwrap().angles;
         let roll_only = Misalignment { pitch: 0.0, ..m };
