@@ -295,9 +295,14 @@ impl MisalignmentWindow {
             centre: shared.pitch + spread.mean,
             variance: spread.variance,
         };
-        let matches = self.frames.back().map_or(&[][..], |f| &f.matches[..]);
-        misaligned::refine_yaws_and_pitch(matches, start, &shared, Some(prior), &self.refine)
-            .map_or(start, |fit| fit.angles)
+        misaligned::refine_yaws_and_pitch(
+            &newest.matches,
+            start,
+            &shared,
+            Some(prior),
+            &self.refine,
+        )
+        .map_or(start, |fit| fit.angles)
     }
 
     /// Takes a new frame's consistent matches (calibrated, with the estimator's weights) and
