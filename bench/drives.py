@@ -108,8 +108,8 @@ def in_venv():
     return os.path.realpath(sys.prefix) == os.path.realpath(VENV)
 
 
-def ensure_venv_and_reexec():
-    """Stdlib only: create the venv, install the packages, re-run this script inside it."""
+def ensure_venv_and_reexec(script=os.path.abspath(__file__)):
+    """Stdlib only: create the venv, install the packages, re-run `script` inside it."""
     if not os.path.exists(VENV_PY):
         print(f"creating {VENV}", file=sys.stderr)
         subprocess.run([sys.executable, "-m", "venv", VENV], check=True)
@@ -118,7 +118,7 @@ def ensure_venv_and_reexec():
     if not have:
         print(f"installing {' '.join(PACKAGES)} into {VENV}", file=sys.stderr)
         subprocess.run([VENV_PY, "-m", "pip", "install", "-q", *PACKAGES], check=True)
-    os.execv(VENV_PY, [VENV_PY, os.path.abspath(__file__), *sys.argv[1:]])
+    os.execv(VENV_PY, [VENV_PY, script, *sys.argv[1:]])
 
 
 # ---------------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 //! or the angles it was commanded to, in the format of `docs/ARCHITECTURE.md` ("Encoders CSV").
 //! The filter takes its change between frames as a control input (`crate::kalman`).
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Header of the first accepted form: the camera yaws in degrees (verge = left − right,
@@ -70,6 +71,18 @@ pub enum EncodersError {
         /// Frames in the sequence.
         frames: usize,
     },
+}
+
+/// Writes an encoders file of the first form: each frame's (left, right) yaws in degrees, with
+/// 9 decimals (a nano-degree, far below any estimate's noise), frames numbered from 0.
+pub fn write_encoders_csv<W: Write>(out: W, yaws_deg: &[(f64, f64)]) -> Result<(), csv::Error> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(YAW_HEADER)?;
+    for (i, (l, r)) in yaws_deg.iter().enumerate() {
+        w.write_record([i.to_string(), format!("{l:.9}"), format!("{r:.9}")])?;
+    }
+    w.flush()?;
+    Ok(())
 }
 
 /// Reads an encoders file for a sequence of `frames` frames: the head's verge (deg) per frame,

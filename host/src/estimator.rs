@@ -30,6 +30,19 @@ use crate::window_overlap::sigma_inflation;
 /// A matched point pair in full-resolution pixels: (left, right).
 pub type PixelPair = ([f64; 2], [f64; 2]);
 
+/// A point pair consistent with a frame's estimate, as `matches.csv` gives it: where each
+/// camera saw the point (full-resolution pixels as the fabric delivered them, so distorted)
+/// and the weight the refinement gave the pair (1 = a typical match).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConsistentPair {
+    /// The left camera's pixel.
+    pub left: [f64; 2],
+    /// The right camera's pixel.
+    pub right: [f64; 2],
+    /// The pair's relative weight in the refinement.
+    pub weight: f64,
+}
+
 /// Which essential-matrix model gives the verge angle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Model {
@@ -203,6 +216,9 @@ pub struct FrameEstimate {
     /// the refinement took them; the misalignment window fits its shared angles to them.
     /// General model: empty.
     pub consistent: Vec<Correspondence>,
+    /// Either model: the point pairs consistent with the estimate, in pixels, with their
+    /// weights; `inliers` of them.
+    pub consistent_pairs: Vec<ConsistentPair>,
 }
 
 /// The per-frame verge estimator.
@@ -571,6 +587,7 @@ impl VergeEstimator {
                 .zip(&cfit.inliers)
                 .filter_map(|(c, &inlier)| inlier.then_some(*c))
                 .collect(),
+            consistent_pairs: Vec::new(),
         };
         let mut inliers = cfit.inliers;
         if self.config.model == Model::General {
@@ -598,13 +615,22 @@ impl VergeEstimator {
             est.residual_px = gfit.residual_sigma * focal;
             inliers = gfit.inliers;
         }
+        est.consistent_pairs = pairs
+            .iter()
+            .zip(weights)
+            .zip(&inliers)
+            .filter(|(_, &inlier)| inlier)
+            .map(|(((left, right), &weight), _)| ConsistentPair {
+                left: *left,
+                right: *right,
+                weight,
+            })
+            .collect();
         if let Some(side) = window_side {
-            let (points, inlier_weights): (Vec<[f64; 2]>, Vec<f64>) = pairs
+            let (points, inlier_weights): (Vec<[f64; 2]>, Vec<f64>) = est
+                .consistent_pairs
                 .iter()
-                .zip(weights)
-                .zip(&inliers)
-                .filter(|(_, &inlier)| inlier)
-                .map(|((pair, w), _)| (pair.0, *w))
+                .map(|p| (p.left, p.weight))
                 .unzip();
             est.sigma_deg *= sigma_inflation(&points, &inlier_weights, side);
         }

@@ -38,6 +38,9 @@ pub struct SessionConfig {
     pub misalignment: Option<WindowConfig>,
     /// How the link is guarded against damage (packing, error correction, loss limit).
     pub link: LinkProtection,
+    /// Keep each frame's consistent point pairs in its record (`matches.csv`); off by default,
+    /// as a record then holds a few hundred pairs of 40 bytes.
+    pub keep_pairs: bool,
 }
 
 impl Default for SessionConfig {
@@ -48,6 +51,7 @@ impl Default for SessionConfig {
             sobel_output: SobelOutput::Rows,
             misalignment: Some(WindowConfig::roll()),
             link: LinkProtection::clean(),
+            keep_pairs: false,
         }
     }
 }
@@ -223,6 +227,8 @@ pub struct Session<L: Link = Threaded> {
     last_timestamp_us: Option<u64>,
     /// The head's verge reading for the next pair submitted ([`Session::encoder_reading`]).
     next_encoder_deg: Option<f64>,
+    /// [`SessionConfig::keep_pairs`].
+    keep_pairs: bool,
     cost: SessionCost,
 }
 
@@ -275,6 +281,7 @@ impl<L: Link> Session<L> {
             early: None,
             last_timestamp_us: None,
             next_encoder_deg: None,
+            keep_pairs: config.keep_pairs,
             cost: SessionCost::default(),
         })
     }
@@ -405,6 +412,7 @@ impl<L: Link> Session<L> {
             dropped_because: None,
             misalignment: None,
             link_loss: None,
+            consistent_pairs: Vec::new(),
         };
         record.dropped_because = match &outcome {
             Some(outcome) => damage_of(outcome),
@@ -440,6 +448,9 @@ impl<L: Link> Session<L> {
                         record.inliers = est.inliers;
                         record.keypoints_per_octave = est.keypoints_per_octave;
                         record.matches_per_octave = est.matches_per_octave;
+                        if self.keep_pairs {
+                            record.consistent_pairs = est.consistent_pairs;
+                        }
                         record.status = match record.link_loss {
                             Some(_) => FrameStatus::Salvaged,
                             None => FrameStatus::Ok,

@@ -201,6 +201,7 @@ pub fn hil(args: &HilArgs) -> anyhow::Result<()> {
         (w, h),
         Finish {
             out: args.out.as_deref(),
+            matches: false,
             json: args.json,
             title: &title,
             json_extra,

@@ -127,6 +127,7 @@ pub fn live(args: &LiveArgs) -> anyhow::Result<()> {
         (u32::from(args.width), u32::from(args.height)),
         Finish {
             out: Some(&args.out),
+            matches: false,
             json: args.json,
             title: &title,
             json_extra: Default::default(),

@@ -14,6 +14,10 @@ use stereocal_hdl::regs::output_mode::SobelOutput;
 pub struct Finish<'a> {
     /// Directory for verge.csv and verge.png, if any.
     pub out: Option<&'a Path>,
+    /// Also matches.csv there (the records keep their pairs: [`SessionConfig::keep_pairs`]).
+    ///
+    /// [`SessionConfig::keep_pairs`]: stereocal::session::SessionConfig::keep_pairs
+    pub matches: bool,
     /// JSON on stdout instead of the table.
     pub json: bool,
     /// Title of the plot and the table.
@@ -53,7 +57,7 @@ pub fn finish(
     how: Finish<'_>,
 ) -> anyhow::Result<()> {
     let written = match how.out {
-        Some(dir) => write_outputs(dir, records, how.title)?,
+        Some(dir) => write_outputs(dir, records, how.title, how.matches)?,
         None => Vec::new(),
     };
     if how.json {

@@ -11,7 +11,7 @@ use stereocal::image_sequence::{GrayFrame, SizeLimits, StereoSequence};
 use stereocal::output::record::FrameRecord;
 use stereocal::output::summary::{Residual, Summary};
 use stereocal::output::verge_csv::read_truth_csv;
-use stereocal::session::{tuned_fabric_config, Session};
+use stereocal::session::{tuned_fabric_config, Session, SessionConfig};
 use stereocal_hdl::regs::MAX_HEIGHT;
 
 use crate::options::EstimateArgs;
@@ -43,12 +43,16 @@ pub struct RunArgs {
     /// reading). The filter predicts each frame's verge change from it instead of detecting it.
     #[arg(long)]
     encoders: Option<PathBuf>,
-    /// Where verge.csv and verge.png go.
+    /// Where verge.csv and verge.png (and matches.csv) go.
     #[arg(long, default_value = "out/run")]
     out: PathBuf,
     /// Frame rate of the sequence (the filter's time step).
     #[arg(long, default_value_t = 30.0, value_parser = parse_fps)]
     fps: f64,
+    /// Also write matches.csv into --out: every frame's point pairs consistent with its
+    /// estimate (pixels, weights), to compare two runs match by match.
+    #[arg(long)]
+    matches: bool,
     #[command(flatten)]
     estimate: EstimateArgs,
     /// Print the summary as one JSON object on stdout.
@@ -90,7 +94,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     // Every octave must have whole pixels, so the fabric's window is a multiple of
     // 2^(octaves-1) on each side; like a grabber's region of interest it starts at the
     // top-left corner, which keeps the intrinsics valid.
-    let config = args.estimate.session_config();
+    let config = SessionConfig {
+        keep_pairs: args.matches,
+        ..args.estimate.session_config()
+    };
     let step = 1usize << (tuned_fabric_config(16, 16, config.sobel_output).octaves - 1);
     let window = (size.0 / step * step, size.1 / step * step);
     if window != size {
@@ -159,6 +166,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         (window.0 as u32, window.1 as u32),
         Finish {
             out: Some(&args.out),
+            matches: args.matches,
             json: args.json,
             title: &title,
             json_extra: Default::default(),

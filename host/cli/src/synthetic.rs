@@ -116,6 +116,7 @@ pub fn eval(args: &EvalArgs) -> anyhow::Result<()> {
         args.estimate.session_config(),
         Finish {
             out: args.out.as_deref(),
+            matches: false,
             json: args.json,
             title: &title,
             json_extra: Default::default(),
@@ -146,6 +147,7 @@ pub fn demo(args: &DemoArgs) -> anyhow::Result<()> {
         SessionConfig::default(),
         Finish {
             out: Some(&args.out),
+            matches: false,
             json: args.json,
             title: &title,
             json_extra: Default::default(),

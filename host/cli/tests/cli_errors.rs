@@ -375,7 +375,7 @@ impl Fixture {
 }
 
 #[test]
-fn inject_into_a_sequence_writes_every_frame_and_its_truth() {
+fn inject_into_a_sequence_writes_every_frame_its_truth_and_its_yaws() {
     let f = Fixture::with_frames(2);
     let output = f.inject(&["--motion", "swing"]);
     assert!(
@@ -390,6 +390,12 @@ fn inject_into_a_sequence_writes_every_frame_and_its_truth() {
     let truth = std::fs::read_to_string(f.out().join("truth.csv")).expect("truth");
     assert_eq!(truth.lines().count(), 3, "{truth}");
     assert!(truth.starts_with("frame,verge_deg\n0,0.0"), "{truth}");
+    let encoders = std::fs::read_to_string(f.out().join("encoders.csv")).expect("encoders");
+    assert_eq!(encoders.lines().count(), 3, "{encoders}");
+    assert!(
+        encoders.starts_with("frame,left_yaw_deg,right_yaw_deg\n0,0.0"),
+        "{encoders}"
+    );
 }
 
 #[test]

@@ -5,6 +5,7 @@
 
 use std::fmt;
 
+use crate::estimator::ConsistentPair;
 use crate::misalignment::MisalignmentEstimate;
 
 /// Whether a frame pair produced a measurement.
@@ -85,6 +86,10 @@ pub struct FrameRecord {
     /// What the link cost the pair's two frames when they were delivered salvaged; `None`
     /// when both arrived whole (or the pair was dropped).
     pub link_loss: Option<LinkLoss>,
+    /// The point pairs consistent with the estimate (`inliers` of them), kept only when the
+    /// session keeps them ([`crate::session::SessionConfig::keep_pairs`]) and the pair has an
+    /// estimate; empty otherwise.
+    pub consistent_pairs: Vec<ConsistentPair>,
 }
 
 /// What a delivered pair lost on the link, both cameras together.

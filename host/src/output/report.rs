@@ -1,9 +1,10 @@
-//! What a run leaves behind: `verge.csv` and `verge.png` in the output directory (both or
-//! neither), and the human-readable summary table.
+//! What a run leaves behind: `verge.csv` and `verge.png` in the output directory, with
+//! `matches.csv` when asked (all or none), and the human-readable summary table.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use crate::output::matches_csv::write_matches_csv;
 use crate::output::output_dir::{OutputError, StagedOutput};
 use crate::output::plot::{draw_verge_plot, PlotError};
 use crate::output::record::FrameRecord;
@@ -20,16 +21,16 @@ pub enum ReportError {
     /// `verge.png` could not be drawn or written.
     #[error(transparent)]
     Plot(#[from] PlotError),
-    /// `verge.csv` could not be written.
-    #[error("{path}: cannot write the verge CSV: {source}")]
+    /// A CSV (`verge.csv`, `matches.csv`) could not be written.
+    #[error("{path}: cannot write the CSV: {source}")]
     Csv {
         /// Its destination in the output directory.
         path: PathBuf,
         /// The CSV writer's error.
         source: csv::Error,
     },
-    /// `verge.csv` could not be created in the staging directory.
-    #[error("{path}: cannot create the verge CSV: {source}")]
+    /// A CSV could not be created in the staging directory.
+    #[error("{path}: cannot create the CSV: {source}")]
     Create {
         /// Its destination in the output directory.
         path: PathBuf,
@@ -38,28 +39,46 @@ pub enum ReportError {
     },
 }
 
-/// Writes `verge.csv` and `verge.png` into `dir`; they appear together, or not at all.
+/// Writes `verge.csv` and `verge.png` into `dir`, and `matches.csv` (each record's consistent
+/// pairs) when `matches`; they appear together, or not at all.
 pub fn write_outputs(
     dir: &Path,
     records: &[FrameRecord],
     title: &str,
+    matches: bool,
 ) -> Result<Vec<PathBuf>, ReportError> {
     let mut staged = StagedOutput::new(dir)?;
-    let csv_path = staged.path("verge.csv");
-    let file = std::fs::File::create(&csv_path).map_err(|source| ReportError::Create {
-        path: dir.join("verge.csv"),
-        source,
+    stage_csv(&mut staged, dir, "verge.csv", |f| {
+        write_verge_csv(f, records)
     })?;
-    write_verge_csv(std::io::BufWriter::new(file), records).map_err(|source| ReportError::Csv {
-        path: dir.join("verge.csv"),
-        source,
-    })?;
+    if matches {
+        stage_csv(&mut staged, dir, "matches.csv", |f| {
+            write_matches_csv(f, records)
+        })?;
+    }
     let png_path = staged.path("verge.png");
     draw_verge_plot(&png_path, records, title).map_err(|e| PlotError {
         path: dir.join("verge.png"),
         ..e
     })?;
     Ok(staged.commit()?)
+}
+
+/// Writes the CSV `name` of `dir` into `staged` with `write`.
+fn stage_csv(
+    staged: &mut StagedOutput,
+    dir: &Path,
+    name: &str,
+    write: impl FnOnce(std::io::BufWriter<std::fs::File>) -> Result<(), csv::Error>,
+) -> Result<(), ReportError> {
+    let file = std::fs::File::create(staged.path(name)).map_err(|source| ReportError::Create {
+        path: dir.join(name),
+        source,
+    })?;
+    write(std::io::BufWriter::new(file)).map_err(|source| ReportError::Csv {
+        path: dir.join(name),
+        source,
+    })
 }
 
 /// Extra lines of the summary table that the JSON summary does not carry.

@@ -204,6 +204,7 @@ mod tests {
             dropped_because: None,
             misalignment: None,
             link_loss: None,
+            consistent_pairs: Vec::new(),
         }
     }
 

@@ -186,6 +186,7 @@ mod tests {
                     frames: 1,
                 }),
                 link_loss: None,
+                consistent_pairs: Vec::new(),
             },
             FrameRecord {
                 frame: 1,
@@ -202,6 +203,7 @@ mod tests {
                 dropped_because: None,
                 misalignment: None,
                 link_loss: None,
+                consistent_pairs: Vec::new(),
             },
             FrameRecord {
                 frame: 2,
@@ -221,6 +223,7 @@ mod tests {
                     packets_lost: 3,
                     keypoints_lost: 7,
                 }),
+                consistent_pairs: Vec::new(),
             },
         ];
         let mut out = Vec::new();

@@ -1,6 +1,7 @@
 //! A sequence made from real rectified frames by injecting an exact verge per frame, written
-//! in the formats every tool reads (`left/`, `right/`, `calib.toml`, `truth.csv`), so that
-//! `stereocal run --truth` measures real-image accuracy through the whole chain.
+//! in the formats every tool reads (`left/`, `right/`, `calib.toml`, `truth.csv`, and the
+//! injected yaws as a head's encoders would read them in `encoders.csv`), so that `stereocal
+//! run --truth` measures real-image accuracy through the whole chain.
 //!
 //! The frames come from one pair repeated (the view never changes, so every error that depends
 //! on the view is constant) or from a recorded sequence, a drive whose content changes every
@@ -25,6 +26,7 @@ use rayon::prelude::*;
 use crate::yaw_warp::{Resampling, YawWarp};
 use crate::SynthError;
 use stereocal::calib::{Calibration, CameraIntrinsics};
+use stereocal::encoders::write_encoders_csv;
 use stereocal::image_sequence::{GrayFrame, StereoSequence};
 use stereocal::output::output_dir::StagingDir;
 use stereocal::output::verge_csv::write_truth_csv;
@@ -185,7 +187,9 @@ fn cropped_camera(camera: &CameraIntrinsics, window: Window) -> CameraIntrinsics
 
 /// Writes `frames` injected pairs of `source` into `dir` (which must not exist or be
 /// empty), warped with `resampling` and cropped to the [`common_window`] of the sequence,
-/// with `calib.toml` (principal points moved with the crop) and `truth.csv`. Everything is
+/// with `calib.toml` (principal points moved with the crop), `truth.csv` and `encoders.csv`
+/// (each frame's two yaws: what maps a point of an injected frame back to its source frame,
+/// and what `run --encoders` takes). Everything is
 /// written to a sibling [`StagingDir`] first and renamed into place, so neither a failure nor
 /// Ctrl-C leaves anything half-written.
 pub fn write_injected(
@@ -268,17 +272,24 @@ pub fn write_injected(
         progress(i);
         Ok::<(), SynthError>(())
     })?;
-    let truth: Vec<f64> = (0..frames)
+    let yaws_deg: Vec<(f64, f64)> = (0..frames)
         .map(|i| {
             let (al, ar) = yaws(motion, i, frames);
-            (al - ar).to_degrees()
+            (al.to_degrees(), ar.to_degrees())
         })
         .collect();
-    let truth_path = staging.path().join("truth.csv");
-    let file = fs::File::create(&truth_path).map_err(io(&truth_path))?;
-    write_truth_csv(std::io::BufWriter::new(file), &truth).map_err(|e| SynthError::Io {
-        path: truth_path.clone(),
-        source: std::io::Error::other(e),
+    let truth: Vec<f64> = yaws_deg.iter().map(|(l, r)| l - r).collect();
+    let write_csv =
+        |name: &str, write: &dyn Fn(std::io::BufWriter<fs::File>) -> std::io::Result<()>| {
+            let path = staging.path().join(name);
+            let file = fs::File::create(&path).map_err(io(&path))?;
+            write(std::io::BufWriter::new(file)).map_err(io(&path))
+        };
+    write_csv("truth.csv", &|f| {
+        write_truth_csv(f, &truth).map_err(std::io::Error::other)
+    })?;
+    write_csv("encoders.csv", &|f| {
+        write_encoders_csv(f, &yaws_deg).map_err(std::io::Error::other)
     })?;
     let calib_path = staging.path().join("calib.toml");
     fs::write(&calib_path, cropped.to_toml_string()).map_err(io(&calib_path))?;
@@ -321,6 +332,22 @@ mod tests {
         let truth = stereocal::output::verge_csv::read_truth_csv(&dir.join("truth.csv")).unwrap();
         let (al, ar) = yaws(Motion::Moving, 2, 4);
         assert!((truth[2] - (al - ar).to_degrees()).abs() < 1e-6);
+        let encoders = fs::read_to_string(dir.join("encoders.csv")).unwrap();
+        let row: Vec<f64> = encoders
+            .lines()
+            .nth(3)
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(
+            encoders.lines().next(),
+            Some("frame,left_yaw_deg,right_yaw_deg")
+        );
+        assert!((row[0] - al.to_degrees()).abs() < 1e-8 && (row[1] - ar.to_degrees()).abs() < 1e-8);
+        let verges = stereocal::encoders::read_encoders_csv(&dir.join("encoders.csv"), 4).unwrap();
+        assert!((verges[2].unwrap() - truth[2]).abs() < 1e-8);
         let written = Calibration::load(dir.join("calib.toml")).unwrap();
         let first = image::open(dir.join("left/000000.png")).unwrap();
         assert_eq!((first.width() % 8, first.height() % 8), (0, 0));

@@ -64,7 +64,7 @@ impl RunSpec {
 impl Run {
     /// `verge.csv` and `verge.png` (fig. 5.1 style) of this run into `dir`.
     pub(crate) fn write(&self, dir: &Path, title: &str) -> Result<Vec<PathBuf>, ExperimentError> {
-        Ok(write_outputs(dir, &self.records, title)?)
+        Ok(write_outputs(dir, &self.records, title, false)?)
     }
 
     /// |raw − truth| of every estimated frame.
