@@ -29,6 +29,12 @@ Per frame, then median (and max) over the frames both runs estimated:
 Were the differential the noise of the matches both runs use, the refit on the matches found
 again would carry it; were it which matches each run finds, that refit would shed it.
 
+A control row, `shift`, needs no verge at all: the untouched frames shifted by half a pixel in
+both directions (OpenCV's bicubic, SHIFT_MARGIN whole pixels cropped off every side, the
+principal points moved with them), so every scene point lands half a pixel off the grid it sat
+on and nothing else changes. Its differential is the verge's change where the truth is none:
+what resampling and the matches a new sampling phase gives cost by themselves.
+
 The first run makes bench/.venv (as bench/drives.py) with numpy, opencv-python-headless and
 scipy, and re-runs itself inside it.
 
@@ -51,6 +57,10 @@ MATCH_PX = 0.75
 # Where the refit's Cauchy loss turns (pixels): the scale of a good match's vertical error on
 # the drive (its robust σ is about 0.1 px), so that a match several σ out weighs little.
 CAUCHY_PX = 0.1
+# The control's shift (pixels, each direction): half a pixel is the phase farthest from the
+# original grid; and its crop (whole pixels a side), beyond the bicubic kernel's reach of 2.
+SHIFT_PX = 0.5
+SHIFT_MARGIN = 8
 
 
 def read_matches(path):
@@ -108,6 +118,36 @@ def verge_refit(xl, xr, w, f):
     fit = scipy.optimize.least_squares(sampson, [0.0, 0.0], loss="cauchy", f_scale=CAUCHY_PX)
     r = sampson(fit.x, weighted=False)
     return float(np.degrees(fit.x[0] - fit.x[1])), float(1.4826 * np.median(np.abs(r)))
+
+
+def shifted(src, dst):
+    """The sequence `src` resampled SHIFT_PX to the left and up, cropped by SHIFT_MARGIN a side
+    to a size the fabric takes (multiples of 8), with calib.toml's principal points moved:
+    pixel p of the output shows what pixel p + SHIFT_MARGIN + SHIFT_PX of the input did."""
+    import cv2
+    import numpy as np
+    import re
+    off = SHIFT_MARGIN + SHIFT_PX
+    for side in ("left", "right"):
+        os.makedirs(os.path.join(dst, side))
+        for name in sorted(os.listdir(os.path.join(src, side))):
+            img = cv2.imread(os.path.join(src, side, name), cv2.IMREAD_GRAYSCALE)
+            if img is None:
+                raise SystemExit(f"cannot read {side}/{name}")
+            h, w = img.shape
+            size = ((w - 2 * SHIFT_MARGIN) // 8 * 8, (h - 2 * SHIFT_MARGIN) // 8 * 8)
+            m = np.float32([[1, 0, off], [0, 1, off]])
+            out = cv2.warpAffine(img.astype(np.float32), m, size,
+                                 flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP)
+            cv2.imwrite(os.path.join(dst, side, os.path.splitext(name)[0] + ".png"),
+                        np.clip(np.rint(out), 0, 255).astype(np.uint8))
+    with open(os.path.join(src, "calib.toml")) as f:
+        text = f.read()
+    # Every principal-point line (both cameras) moves by the same offset.
+    moved = re.sub(r"^(c[xy])\s*=\s*(\S+)\s*$",
+                   lambda m: f"{m.group(1)} = {float(m.group(2)) - off!r}", text, flags=re.M)
+    with open(os.path.join(dst, "calib.toml"), "w") as f:
+        f.write(moved)
 
 
 def run_matches(binary, seq, out, run_args):
@@ -177,18 +217,23 @@ def main():
             print(f"{name}: untouched", file=sys.stderr)
             m_u, v_u = run_matches(binary, d, os.path.join(work, f"{name}_untouched_out"),
                                    seq_args)
-            for traj in TRAJECTORIES:
+            for traj in ("shift", *TRAJECTORIES):
                 print(f"{name}: {traj}", file=sys.stderr)
                 seq = os.path.join(work, f"{name}_{traj}")
-                sh([binary, "inject", "--left", os.path.join(d, "left"), "--right",
-                    os.path.join(d, "right"), "--calib", os.path.join(d, "calib.toml"),
-                    "--motion", traj, "--out", seq])
+                if traj == "shift":
+                    shifted(d, seq)
+                    yaws = [(0.0, 0.0)] * len(v_u)
+                    truth = [0.0] * len(v_u)
+                else:
+                    sh([binary, "inject", "--left", os.path.join(d, "left"), "--right",
+                        os.path.join(d, "right"), "--calib", os.path.join(d, "calib.toml"),
+                        "--motion", traj, "--out", seq])
+                    yaws = read_yaws(os.path.join(seq, "encoders.csv"))
+                    truth = read_truth(os.path.join(seq, "truth.csv"))
                 inj = read_calib(os.path.join(seq, "calib.toml"))
                 m_i, v_i = run_matches(binary, seq, os.path.join(work, f"{name}_{traj}_out"),
                                        seq_args)
-                rows = compare(m_u, m_i, cams_u, (inj["left"], inj["right"]),
-                               read_yaws(os.path.join(seq, "encoders.csv")), f)
-                truth = read_truth(os.path.join(seq, "truth.csv"))
+                rows = compare(m_u, m_i, cams_u, (inj["left"], inj["right"]), yaws, f)
                 ours = [abs(i["raw"] - u["raw"] - t) for i, u, t in zip(v_i, v_u, truth)
                         if i["raw"] is not None and u["raw"] is not None]
                 table.append((name, traj, rows, ours))
