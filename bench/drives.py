@@ -405,6 +405,14 @@ def write_frames_csv(path, truth, ours, ours_u, sift, sift_u):
                         fmt(sift_u[i]["raw"]), sift[i]["matches"], sift[i]["inliers"]])
 
 
+def split_run_args(argv):
+    """(the script's own arguments, the `stereocal run` flags after `--`)."""
+    if "--" not in argv:
+        return argv, []
+    cut = argv.index("--")
+    return argv[:cut], argv[cut + 1:]
+
+
 def main():
     import argparse
     import platform
@@ -412,9 +420,7 @@ def main():
     import tempfile
     import cv2
 
-    argv = sys.argv[1:]
-    run_args = argv[argv.index("--") + 1:] if "--" in argv else []
-    argv = argv[:argv.index("--")] if "--" in argv else argv
+    argv, run_args = split_run_args(sys.argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--keep", action="store_true", help="keep the work directory")
     ap.add_argument("--csv", help="write per-frame CSVs into this directory")

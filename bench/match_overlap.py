@@ -48,7 +48,8 @@ import subprocess
 import sys
 
 from drives import (FRAME_RATES, ROOT, TRAJECTORIES, ensure_venv_and_reexec, in_venv, read_calib,
-                    read_truth, read_verge_csv, real_data, rectified_sequences, sh)
+                    read_truth, read_verge_csv, real_data, rectified_sequences, sh,
+                    split_run_args)
 
 # Two left points closer than this (pixels) are one scene point found again: the fabric's
 # keypoints sit on whole pixels and the mapped-back point anywhere between them, so the same
@@ -190,9 +191,7 @@ def main():
     import tempfile
     import numpy as np
 
-    argv = sys.argv[1:]
-    run_args = argv[argv.index("--") + 1:] if "--" in argv else []
-    argv = argv[:argv.index("--")] if "--" in argv else argv
+    argv, run_args = split_run_args(sys.argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--keep", action="store_true", help="keep the work directory")
     args = ap.parse_args(argv)

@@ -397,23 +397,7 @@ impl<L: Link> Session<L> {
         encoder_verge_deg: Option<f64>,
         truth_deg: Option<f64>,
     ) -> Result<FrameRecord, SessionError> {
-        let mut record = FrameRecord {
-            frame,
-            raw_verge_deg: None,
-            raw_sigma_deg: None,
-            filtered_verge_deg: None,
-            filtered_sigma_deg: None,
-            matches: 0,
-            inliers: 0,
-            keypoints_per_octave: Vec::new(),
-            matches_per_octave: Vec::new(),
-            status: FrameStatus::Dropped,
-            truth_deg,
-            dropped_because: None,
-            misalignment: None,
-            link_loss: None,
-            consistent_pairs: Vec::new(),
-        };
+        let mut record = FrameRecord::dropped(frame, truth_deg);
         record.dropped_because = match &outcome {
             Some(outcome) => damage_of(outcome),
             None => Some(missing.to_owned()),

@@ -11,7 +11,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{stereocal, succeeded};
+use common::{stereocal, succeeded, synth_road};
 use stereocal::calib::{Calibration, Extrinsics};
 use stereocal::output::verge_csv::read_truth_csv;
 
@@ -92,17 +92,7 @@ fn the_starting_verge_and_misalignments_come_from_r_and_t() {
 fn run_on_each_format_estimates_what_run_on_the_toml_does() {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("seq");
-    succeeded(stereocal(&[
-        "synth",
-        "--scene",
-        "road",
-        "--frames",
-        "4",
-        "--seed",
-        "3",
-        "--out",
-        seq.to_str().unwrap(),
-    ]));
+    synth_road(&seq, 4, 3);
     let run = |calib: &str| {
         let out = dir.path().join(calib);
         let summary = succeeded(stereocal(&[

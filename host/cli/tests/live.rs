@@ -12,7 +12,7 @@ use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use common::{stereocal, succeeded};
+use common::{stereocal, succeeded, synth_road};
 use std::thread;
 use std::time::Duration;
 
@@ -25,18 +25,7 @@ const PERIOD_US: f64 = 1e6 / 30.0;
 
 /// Renders the road sequence into `dir` (left/, right/, calib.toml).
 fn synth(dir: &Path) -> (u32, u32) {
-    let out = stereocal(&[
-        "synth",
-        "--scene",
-        "road",
-        "--frames",
-        &FRAMES.to_string(),
-        "--seed",
-        "3",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    succeeded(out);
+    synth_road(dir, FRAMES, 3);
     image::open(dir.join("left").join(first_file(&dir.join("left"))))
         .expect("rendered image")
         .to_luma8()

@@ -7,7 +7,7 @@ mod common;
 
 use std::collections::BTreeMap;
 
-use common::{stereocal, succeeded};
+use common::{stereocal, succeeded, synth_road};
 use stereocal::calib::Calibration;
 use stereocal::estimator::{EstimatorConfig, PixelPair, VergeEstimator};
 use stereocal::output::verge_csv::read_truth_csv;
@@ -17,17 +17,7 @@ fn matches_csv_holds_each_frames_consistent_pairs() {
     let dir = tempfile::tempdir().unwrap();
     let seq = dir.path().join("seq");
     let path = |p: &std::path::Path| p.to_str().unwrap().to_owned();
-    succeeded(stereocal(&[
-        "synth",
-        "--scene",
-        "road",
-        "--frames",
-        "4",
-        "--seed",
-        "3",
-        "--out",
-        &path(&seq),
-    ]));
+    synth_road(&seq, 4, 3);
     let run = |out: &std::path::Path, extra: &[&str]| {
         let args = [
             "run".to_owned(),

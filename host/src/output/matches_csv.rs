@@ -40,21 +40,10 @@ mod tests {
 
     fn record(frame: usize, pairs: Vec<ConsistentPair>) -> FrameRecord {
         FrameRecord {
-            frame,
-            raw_verge_deg: None,
-            raw_sigma_deg: None,
-            filtered_verge_deg: None,
-            filtered_sigma_deg: None,
-            matches: 0,
             inliers: pairs.len(),
-            keypoints_per_octave: Vec::new(),
-            matches_per_octave: Vec::new(),
             status: FrameStatus::Ok,
-            truth_deg: None,
-            dropped_because: None,
-            misalignment: None,
-            link_loss: None,
             consistent_pairs: pairs,
+            ..FrameRecord::dropped(frame, None)
         }
     }
 

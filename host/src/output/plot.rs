@@ -171,25 +171,17 @@ mod tests {
                 let ok = i % 7 != 3;
                 let v = (i as f64 * 0.1).sin() * 10.0;
                 FrameRecord {
-                    frame: i,
                     raw_verge_deg: ok.then_some(v + 0.01),
-                    raw_sigma_deg: None,
                     filtered_verge_deg: ok.then_some(v),
                     filtered_sigma_deg: ok.then_some(0.01),
                     matches: 30,
                     inliers: 28,
-                    keypoints_per_octave: Vec::new(),
-                    matches_per_octave: Vec::new(),
                     status: if ok {
                         FrameStatus::Ok
                     } else {
                         FrameStatus::Dropped
                     },
-                    truth_deg: Some(v),
-                    dropped_because: None,
-                    misalignment: None,
-                    link_loss: None,
-                    consistent_pairs: Vec::new(),
+                    ..FrameRecord::dropped(i, Some(v))
                 }
             })
             .collect();

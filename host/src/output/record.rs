@@ -92,6 +92,30 @@ pub struct FrameRecord {
     pub consistent_pairs: Vec<ConsistentPair>,
 }
 
+impl FrameRecord {
+    /// The record of pair `frame` before anything about it is known: `Dropped`, with no
+    /// measurement, counts or losses; the session fills in what the pair brings.
+    pub fn dropped(frame: usize, truth_deg: Option<f64>) -> Self {
+        Self {
+            frame,
+            raw_verge_deg: None,
+            raw_sigma_deg: None,
+            filtered_verge_deg: None,
+            filtered_sigma_deg: None,
+            matches: 0,
+            inliers: 0,
+            keypoints_per_octave: Vec::new(),
+            matches_per_octave: Vec::new(),
+            status: FrameStatus::Dropped,
+            truth_deg,
+            dropped_because: None,
+            misalignment: None,
+            link_loss: None,
+            consistent_pairs: Vec::new(),
+        }
+    }
+}
+
 /// What a delivered pair lost on the link, both cameras together.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LinkLoss {

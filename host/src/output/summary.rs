@@ -190,21 +190,13 @@ mod tests {
 
     fn rec(frame: usize, raw: Option<f64>, truth: f64, status: FrameStatus) -> FrameRecord {
         FrameRecord {
-            frame,
             raw_verge_deg: raw,
-            raw_sigma_deg: None,
             filtered_verge_deg: raw,
             filtered_sigma_deg: raw.map(|_| 0.01),
             matches: 100,
             inliers: 90,
-            keypoints_per_octave: Vec::new(),
-            matches_per_octave: Vec::new(),
             status,
-            truth_deg: Some(truth),
-            dropped_because: None,
-            misalignment: None,
-            link_loss: None,
-            consistent_pairs: Vec::new(),
+            ..FrameRecord::dropped(frame, Some(truth))
         }
     }
 

@@ -163,18 +163,13 @@ mod tests {
     fn verge_csv_has_contract_header_and_empty_fields_without_estimate() {
         let records = [
             FrameRecord {
-                frame: 0,
                 raw_verge_deg: Some(1.25),
                 raw_sigma_deg: Some(0.02),
                 filtered_verge_deg: Some(1.2),
                 filtered_sigma_deg: Some(0.01),
                 matches: 40,
                 inliers: 38,
-                keypoints_per_octave: Vec::new(),
-                matches_per_octave: Vec::new(),
                 status: FrameStatus::Ok,
-                truth_deg: Some(1.3),
-                dropped_because: None,
                 misalignment: Some(MisalignmentEstimate {
                     pitch_deg: 0.01,
                     roll_deg: -0.03,
@@ -185,45 +180,26 @@ mod tests {
                     pitch_spread_deg: 0.0,
                     frames: 1,
                 }),
-                link_loss: None,
-                consistent_pairs: Vec::new(),
+                ..FrameRecord::dropped(0, Some(1.3))
             },
             FrameRecord {
-                frame: 1,
-                raw_verge_deg: None,
-                raw_sigma_deg: None,
-                filtered_verge_deg: None,
-                filtered_sigma_deg: None,
                 matches: 2,
-                inliers: 0,
-                keypoints_per_octave: Vec::new(),
-                matches_per_octave: Vec::new(),
                 status: FrameStatus::NoEstimate,
-                truth_deg: None,
-                dropped_because: None,
-                misalignment: None,
-                link_loss: None,
-                consistent_pairs: Vec::new(),
+                ..FrameRecord::dropped(1, None)
             },
             FrameRecord {
-                frame: 2,
                 raw_verge_deg: Some(1.5),
                 raw_sigma_deg: Some(0.03),
                 filtered_verge_deg: Some(1.3),
                 filtered_sigma_deg: Some(0.01),
                 matches: 30,
                 inliers: 29,
-                keypoints_per_octave: Vec::new(),
-                matches_per_octave: Vec::new(),
                 status: FrameStatus::Salvaged,
-                truth_deg: None,
-                dropped_because: None,
-                misalignment: None,
                 link_loss: Some(LinkLoss {
                     packets_lost: 3,
                     keypoints_lost: 7,
                 }),
-                consistent_pairs: Vec::new(),
+                ..FrameRecord::dropped(2, None)
             },
         ];
         let mut out = Vec::new();

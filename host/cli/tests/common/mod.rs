@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 use std::ffi::OsStr;
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// The `stereocal` binary Cargo built for these tests.
@@ -34,4 +35,20 @@ pub fn succeeded(out: Output) -> Output {
         String::from_utf8_lossy(&out.stderr)
     );
     out
+}
+
+/// `stereocal synth --scene road --frames FRAMES --seed SEED --out OUT`, which must succeed:
+/// the rendered road with exact truth (left/, right/, calib.toml, truth.csv, ...).
+pub fn synth_road(out: &Path, frames: usize, seed: u64) {
+    succeeded(stereocal(&[
+        "synth",
+        "--scene",
+        "road",
+        "--frames",
+        &frames.to_string(),
+        "--seed",
+        &seed.to_string(),
+        "--out",
+        out.to_str().expect("a UTF-8 path"),
+    ]));
 }

@@ -276,21 +276,10 @@ mod tests {
 
     fn record(status: FrameStatus, matches: Vec<usize>) -> FrameRecord {
         FrameRecord {
-            frame: 0,
-            raw_verge_deg: None,
-            raw_sigma_deg: None,
-            filtered_verge_deg: None,
-            filtered_sigma_deg: None,
             matches: matches.iter().sum(),
-            inliers: 0,
-            keypoints_per_octave: Vec::new(),
             matches_per_octave: matches,
             status,
-            truth_deg: None,
-            dropped_because: None,
-            misalignment: None,
-            link_loss: None,
-            consistent_pairs: Vec::new(),
+            ..FrameRecord::dropped(0, None)
         }
     }
 
