@@ -29,11 +29,13 @@ Per frame, then median (and max) over the frames both runs estimated:
 Were the differential the noise of the matches both runs use, the refit on the matches found
 again would carry it; were it which matches each run finds, that refit would shed it.
 
-A control row, `shift`, needs no verge at all: the untouched frames shifted by half a pixel in
-both directions (OpenCV's bicubic, SHIFT_MARGIN whole pixels cropped off every side, the
-principal points moved with them), so every scene point lands half a pixel off the grid it sat
-on and nothing else changes. Its differential is the verge's change where the truth is none:
-what resampling and the matches a new sampling phase gives cost by themselves.
+Control rows, `shift X, Y`, need no verge at all: the untouched frames resampled X pixels to
+the left and Y up (OpenCV's bicubic, SHIFT_MARGIN whole pixels cropped off every side, the
+principal points moved with them), so every scene point lands off the grid it sat on and
+nothing else changes; one row per phase of SHIFTS, and a row pooling their frames. Their
+differential is the verge's change where the truth is none: what resampling and the matches a
+new sampling phase gives cost by themselves. Pooled over several phases it is a steadier figure
+than any one trajectory's (four draws of each frame's matches, not one), for comparing settings.
 
 The first run makes bench/.venv (as bench/drives.py) with numpy, opencv-python-headless and
 scipy, and re-runs itself inside it.
@@ -58,9 +60,10 @@ MATCH_PX = 0.75
 # Where the refit's Cauchy loss turns (pixels): the scale of a good match's vertical error on
 # the drive (its robust σ is about 0.1 px), so that a match several σ out weighs little.
 CAUCHY_PX = 0.1
-# The control's shift (pixels, each direction): half a pixel is the phase farthest from the
-# original grid; and its crop (whole pixels a side), beyond the bicubic kernel's reach of 2.
-SHIFT_PX = 0.5
+# The controls' shifts (pixels, x and y): half a pixel in both directions, the phase farthest
+# from the original grid, in each direction alone, and a quarter and three quarters between;
+# and their crop (whole pixels a side), beyond the bicubic kernel's reach of 2.
+SHIFTS = ((0.5, 0.5), (0.5, 0.0), (0.0, 0.5), (0.25, 0.75))
 SHIFT_MARGIN = 8
 
 
@@ -121,14 +124,15 @@ def verge_refit(xl, xr, w, f):
     return float(np.degrees(fit.x[0] - fit.x[1])), float(1.4826 * np.median(np.abs(r)))
 
 
-def shifted(src, dst):
-    """The sequence `src` resampled SHIFT_PX to the left and up, cropped by SHIFT_MARGIN a side
-    to a size the fabric takes (multiples of 8), with calib.toml's principal points moved:
-    pixel p of the output shows what pixel p + SHIFT_MARGIN + SHIFT_PX of the input did."""
+def shifted(src, dst, shift):
+    """The sequence `src` resampled `shift` = (x, y) pixels to the left and up, cropped by
+    SHIFT_MARGIN a side to a size the fabric takes (multiples of 8), with calib.toml's principal
+    points moved: pixel p of the output shows what pixel p + SHIFT_MARGIN + shift of the input
+    did."""
     import cv2
     import numpy as np
     import re
-    off = SHIFT_MARGIN + SHIFT_PX
+    off = (SHIFT_MARGIN + shift[0], SHIFT_MARGIN + shift[1])
     for side in ("left", "right"):
         os.makedirs(os.path.join(dst, side))
         for name in sorted(os.listdir(os.path.join(src, side))):
@@ -137,7 +141,7 @@ def shifted(src, dst):
                 raise SystemExit(f"cannot read {side}/{name}")
             h, w = img.shape
             size = ((w - 2 * SHIFT_MARGIN) // 8 * 8, (h - 2 * SHIFT_MARGIN) // 8 * 8)
-            m = np.float32([[1, 0, off], [0, 1, off]])
+            m = np.float32([[1, 0, off[0]], [0, 1, off[1]]])
             out = cv2.warpAffine(img.astype(np.float32), m, size,
                                  flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP)
             cv2.imwrite(os.path.join(dst, side, os.path.splitext(name)[0] + ".png"),
@@ -145,8 +149,9 @@ def shifted(src, dst):
     with open(os.path.join(src, "calib.toml")) as f:
         text = f.read()
     # Every principal-point line (both cameras) moves by the same offset.
-    moved = re.sub(r"^(c[xy])\s*=\s*(\S+)\s*$",
-                   lambda m: f"{m.group(1)} = {float(m.group(2)) - off!r}", text, flags=re.M)
+    moved = re.sub(r"^c([xy])\s*=\s*(\S+)\s*$",
+                   lambda m: f"c{m.group(1)} = {float(m.group(2)) - off['xy'.index(m.group(1))]!r}",
+                   text, flags=re.M)
     with open(os.path.join(dst, "calib.toml"), "w") as f:
         f.write(moved)
 
@@ -216,11 +221,13 @@ def main():
             print(f"{name}: untouched", file=sys.stderr)
             m_u, v_u = run_matches(binary, d, os.path.join(work, f"{name}_untouched_out"),
                                    seq_args)
-            for traj in ("shift", *TRAJECTORIES):
+            shifts = {f"shift {x:g}, {y:g}": (x, y) for x, y in SHIFTS}
+            pooled = ([], [])
+            for traj in (*shifts, *TRAJECTORIES):
                 print(f"{name}: {traj}", file=sys.stderr)
-                seq = os.path.join(work, f"{name}_{traj}")
-                if traj == "shift":
-                    shifted(d, seq)
+                seq = os.path.join(work, f"{name}_{traj}".replace(" ", "").replace(",", "_"))
+                if traj in shifts:
+                    shifted(d, seq, shifts[traj])
                     yaws = [(0.0, 0.0)] * len(v_u)
                     truth = [0.0] * len(v_u)
                 else:
@@ -236,6 +243,11 @@ def main():
                 ours = [abs(i["raw"] - u["raw"] - t) for i, u, t in zip(v_i, v_u, truth)
                         if i["raw"] is not None and u["raw"] is not None]
                 table.append((name, traj, rows, ours))
+                if traj in shifts:
+                    pooled[0].extend(rows)
+                    pooled[1].extend(ours)
+                    if len(table) and traj == list(shifts)[-1]:
+                        table.append((name, f"shift, {len(shifts)} phases pooled", *pooled))
     finally:
         if args.keep:
             print(f"work directory kept: {work}", file=sys.stderr)
