@@ -174,6 +174,31 @@ def read_verge_csv(path):
     return rows
 
 
+def normalised(px, cam):
+    """Pixels (N x 2) of `cam` (a camera table of calib.toml) as calibrated rays (N x 2): the
+    pinhole model a rectified sequence's calibration gives."""
+    return (px - [cam["cx"], cam["cy"]]) / [cam["fx"], cam["fy"]]
+
+
+def essential(al, ar):
+    """E of the two-yaw model `stereocal run` fits by default: each camera yawed about its own
+    y axis (a_l, a_r radians), baseline (b, 0, 0); host/src/essential.rs."""
+    import numpy as np
+    return np.array([[0.0, -np.sin(ar), 0.0],
+                     [np.sin(al), 0.0, -np.cos(al)],
+                     [0.0, np.cos(ar), 0.0]])
+
+
+def sampson(e, xl, xr):
+    """Signed Sampson distances (calibrated units) of homogeneous rays xl, xr (N x 3)."""
+    import numpy as np
+    ex = xl @ e.T
+    etx = xr @ e
+    num = np.sum(xr * ex, axis=1)
+    den = np.sqrt(ex[:, 0] ** 2 + ex[:, 1] ** 2 + etx[:, 0] ** 2 + etx[:, 1] ** 2)
+    return num / np.maximum(den, 1e-15)
+
+
 class SiftVerge:
     """A verge-only (two-yaw) fit to OpenCV SIFT matches; see the module doc."""
 
@@ -187,24 +212,6 @@ class SiftVerge:
         self.matcher = cv2.BFMatcher(cv2.NORM_L2)
         self.rng = np.random.default_rng(1)
 
-    def _normalise(self, pts, c):
-        return (pts - [c["cx"], c["cy"]]) / [c["fx"], c["fy"]]
-
-    @staticmethod
-    def essential(np, al, ar):
-        return np.array([[0.0, -np.sin(ar), 0.0],
-                         [np.sin(al), 0.0, -np.cos(al)],
-                         [0.0, np.cos(ar), 0.0]])
-
-    def sampson(self, e, xl, xr):
-        """Signed Sampson distances (calibrated units) of homogeneous rays xl, xr (N x 3)."""
-        np = self.np
-        ex = xl @ e.T
-        etx = xr @ e
-        num = np.sum(xr * ex, axis=1)
-        den = np.sqrt(ex[:, 0] ** 2 + ex[:, 1] ** 2 + etx[:, 0] ** 2 + etx[:, 1] ** 2)
-        return num / np.maximum(den, 1e-15)
-
     def matches(self, img_l, img_r):
         np = self.np
         kp_l, des_l = self.sift.detectAndCompute(img_l, None)
@@ -216,8 +223,8 @@ class SiftVerge:
         p_l = np.float64([kp_l[m.queryIdx].pt for m in good]).reshape(-1, 2)
         p_r = np.float64([kp_r[m.trainIdx].pt for m in good]).reshape(-1, 2)
         ones = np.ones((len(good), 1))
-        xl = np.hstack([self._normalise(p_l, self.cams[0]), ones])
-        xr = np.hstack([self._normalise(p_r, self.cams[1]), ones])
+        xl = np.hstack([normalised(p_l, self.cams[0]), ones])
+        xr = np.hstack([normalised(p_r, self.cams[1]), ones])
         return xl, xr
 
     def estimate(self, img_l, img_r):
@@ -237,18 +244,18 @@ class SiftVerge:
             if e3 - e4 < 0:  # cos a_r = e3 and cos a_l = -e4 are positive
                 e1, e2, e3, e4 = -e1, -e2, -e3, -e4
             al, ar = np.arctan2(e2, -e4), np.arctan2(-e1, e3)
-            n = int(np.sum(np.abs(self.sampson(self.essential(np, al, ar), xl, xr)) < thresh))
+            n = int(np.sum(np.abs(sampson(essential(al, ar), xl, xr)) < thresh))
             if best is None or n > best[0]:
                 best = (n, al, ar)
         n, al, ar = best
         if n < 3:
             return None, len(xl), n
-        inl = np.abs(self.sampson(self.essential(np, al, ar), xl, xr)) < thresh
+        inl = np.abs(sampson(essential(al, ar), xl, xr)) < thresh
         fit = scipy.optimize.least_squares(
-            lambda p: self.sampson(self.essential(np, p[0], p[1]), xl[inl], xr[inl]) * self.f,
+            lambda p: sampson(essential(p[0], p[1]), xl[inl], xr[inl]) * self.f,
             [al, ar], loss="huber", f_scale=HUBER_PX)
         al, ar = fit.x
-        inliers = int(np.sum(np.abs(self.sampson(self.essential(np, al, ar), xl, xr)) < thresh))
+        inliers = int(np.sum(np.abs(sampson(essential(al, ar), xl, xr)) < thresh))
         return float(np.degrees(al - ar)), len(xl), inliers
 
 

@@ -49,9 +49,9 @@ import os
 import subprocess
 import sys
 
-from drives import (FRAME_RATES, ROOT, TRAJECTORIES, ensure_venv_and_reexec, in_venv, read_calib,
-                    read_truth, read_verge_csv, real_data, rectified_sequences, sh,
-                    split_run_args)
+from drives import (FRAME_RATES, ROOT, TRAJECTORIES, ensure_venv_and_reexec, essential, in_venv,
+                    normalised, read_calib, read_truth, read_verge_csv, real_data,
+                    rectified_sequences, sampson, sh, split_run_args)
 
 # Two left points closer than this (pixels) are one scene point found again: the fabric's
 # keypoints sit on whole pixels and the mapped-back point anywhere between them, so the same
@@ -85,11 +85,6 @@ def read_yaws(path):
     return [(np.radians(l), np.radians(r)) for l, r in data[:, 1:3]]
 
 
-def rays(px, cam):
-    import numpy as np
-    return (px - [cam["cx"], cam["cy"]]) / [cam["fx"], cam["fy"]]
-
-
 def ry(a):
     import numpy as np
     c, s = np.cos(a), np.sin(a)
@@ -109,18 +104,13 @@ def verge_refit(xl, xr, w, f):
     import numpy as np
     import scipy.optimize
 
-    def sampson(p, weighted=True):
-        al, ar = p
-        e = np.array([[0.0, -np.sin(ar), 0.0], [np.sin(al), 0.0, -np.cos(al)],
-                      [0.0, np.cos(ar), 0.0]])
-        lh = np.hstack([xl, np.ones((len(xl), 1))])
-        rh = np.hstack([xr, np.ones((len(xr), 1))])
-        ex, etx = lh @ e.T, rh @ e
-        den = np.sqrt(ex[:, 0] ** 2 + ex[:, 1] ** 2 + etx[:, 0] ** 2 + etx[:, 1] ** 2)
-        return np.sum(rh * ex, axis=1) / den * f * (np.sqrt(w) if weighted else 1.0)
+    lh = np.hstack([xl, np.ones((len(xl), 1))])
+    rh = np.hstack([xr, np.ones((len(xr), 1))])
+    residuals = lambda p: sampson(essential(*p), lh, rh) * f
 
-    fit = scipy.optimize.least_squares(sampson, [0.0, 0.0], loss="cauchy", f_scale=CAUCHY_PX)
-    r = sampson(fit.x, weighted=False)
+    fit = scipy.optimize.least_squares(lambda p: residuals(p) * np.sqrt(w), [0.0, 0.0],
+                                       loss="cauchy", f_scale=CAUCHY_PX)
+    r = residuals(fit.x)
     return float(np.degrees(fit.x[0] - fit.x[1])), float(1.4826 * np.median(np.abs(r)))
 
 
@@ -173,9 +163,9 @@ def compare(untouched, injected, cams_u, cams_i, yaws, f):
             continue
         il, ir, iw = injected[frame]
         al, ar = yaws[frame]
-        xul, xur = rays(ul, cams_u[0]), rays(ur, cams_u[1])
-        xil = mapped_back(rays(il, cams_i[0]), al)
-        xir = mapped_back(rays(ir, cams_i[1]), ar)
+        xul, xur = normalised(ul, cams_u[0]), normalised(ur, cams_u[1])
+        xil = mapped_back(normalised(il, cams_i[0]), al)
+        xir = mapped_back(normalised(ir, cams_i[1]), ar)
         dist = np.linalg.norm(xul[:, None, :] - xil[None, :, :], axis=2) * f
         nearest = dist.argmin(axis=1)
         again = dist[np.arange(len(xul)), nearest] < MATCH_PX
@@ -226,6 +216,7 @@ def main():
             for traj in (*shifts, *TRAJECTORIES):
                 print(f"{name}: {traj}", file=sys.stderr)
                 seq = os.path.join(work, f"{name}_{traj}".replace(" ", "").replace(",", "_"))
+                out = seq + "_out"
                 if traj in shifts:
                     shifted(d, seq, shifts[traj])
                     yaws = [(0.0, 0.0)] * len(v_u)
@@ -237,8 +228,7 @@ def main():
                     yaws = read_yaws(os.path.join(seq, "encoders.csv"))
                     truth = read_truth(os.path.join(seq, "truth.csv"))
                 inj = read_calib(os.path.join(seq, "calib.toml"))
-                m_i, v_i = run_matches(binary, seq, os.path.join(work, f"{name}_{traj}_out"),
-                                       seq_args)
+                m_i, v_i = run_matches(binary, seq, out, seq_args)
                 rows = compare(m_u, m_i, cams_u, (inj["left"], inj["right"]), yaws, f)
                 ours = [abs(i["raw"] - u["raw"] - t) for i, u, t in zip(v_i, v_u, truth)
                         if i["raw"] is not None and u["raw"] is not None]
@@ -246,7 +236,7 @@ def main():
                 if traj in shifts:
                     pooled[0].extend(rows)
                     pooled[1].extend(ours)
-                    if len(table) and traj == list(shifts)[-1]:
+                    if traj == list(shifts)[-1]:
                         table.append((name, f"shift, {len(shifts)} phases pooled", *pooled))
     finally:
         if args.keep:
