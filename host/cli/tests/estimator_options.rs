@@ -94,7 +94,7 @@ impl Effect {
 #[test]
 fn every_optional_mode_estimates_the_verge() {
     let default = eval(&[]);
-    let modes: [(&[&str], Effect, f64); 17] = [
+    let modes: [(&[&str], Effect, f64); 18] = [
         (&["--descriptor", "reduced16"], Effect::OtherMatches, 0.05),
         (&["--rotate"], Effect::OtherMatches, 0.05),
         (&["--no-cross-check"], Effect::OtherMatches, 0.05),
@@ -133,6 +133,12 @@ fn every_optional_mode_estimates_the_verge() {
         ),
         // Grid points add guided matches, not descriptor matches.
         (&["--grid", "12"], Effect::SameMatchesOtherEstimates, 0.05),
+        // The disparity gradient moves refined points, not the descriptor matches.
+        (
+            &["--disparity-gradient"],
+            Effect::SameMatchesOtherEstimates,
+            0.05,
+        ),
         (&["--sobel", "patches"], Effect::WireBytesAtMost(0.6), 0.1),
         // Parity and smaller packets change the bytes on the link, not what arrives.
         (
