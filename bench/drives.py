@@ -276,6 +276,14 @@ def run_sift(seq_left, seq_right, calib_path):
     return out
 
 
+def built_binary():
+    """The release `stereocal`, built first (cargo rebuilds only what changed)."""
+    print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal-cli"], cwd=ROOT,
+                   check=True)
+    return os.path.join(ROOT, "target", "release", "stereocal")
+
+
 def sh(args, cwd=ROOT, env=None):
     """`args`' stdout; a failure ends the script with the command and its stderr."""
     p = subprocess.run(args, cwd=cwd, env=env, capture_output=True, text=True)
@@ -442,9 +450,7 @@ def main():
     data = real_data()
     if not os.path.isdir(data):
         raise SystemExit(f"no real data at {data} (set STEREOCAL_REAL_DATA)")
-    print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal-cli"], cwd=ROOT, check=True)
-    binary = os.path.join(ROOT, "target", "release", "stereocal")
+    binary = built_binary()
     if args.csv:
         os.makedirs(args.csv, exist_ok=True)
 

@@ -21,11 +21,10 @@ Usage: bench/large_verge.py [-- EVAL_ARGS...]
 
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
-from drives import ROOT, sh, split_run_args
+from drives import built_binary, sh, split_run_args
 
 # Scenes other than the test's seed 3: two layouts, trajectories and noise draws.
 SEEDS = (5, 7)
@@ -39,10 +38,7 @@ def main():
     own, eval_args = split_run_args(sys.argv[1:])
     if own:
         raise SystemExit(__doc__)
-    print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal-cli"], cwd=ROOT,
-                   check=True)
-    binary = os.path.join(ROOT, "target", "release", "stereocal")
+    binary = built_binary()
     rows = []
     with tempfile.TemporaryDirectory(prefix="large_verge.") as work:
         for seed in SEEDS:

@@ -46,11 +46,10 @@ Usage: bench/match_overlap.py [--keep] [-- RUN_ARGS...]
 """
 
 import os
-import subprocess
 import sys
 
-from drives import (FRAME_RATES, ROOT, TRAJECTORIES, ensure_venv_and_reexec, essential, in_venv,
-                    normalised, read_calib, read_truth, read_verge_csv, real_data,
+from drives import (FRAME_RATES, TRAJECTORIES, built_binary, ensure_venv_and_reexec, essential,
+                    in_venv, normalised, read_calib, read_truth, read_verge_csv, real_data,
                     rectified_sequences, sampson, sh, split_run_args)
 
 # Two left points closer than this (pixels) are one scene point found again: the fabric's
@@ -194,10 +193,7 @@ def main():
     data = real_data()
     if not os.path.isdir(data):
         raise SystemExit(f"no real data at {data} (set STEREOCAL_REAL_DATA)")
-    print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal-cli"], cwd=ROOT,
-                   check=True)
-    binary = os.path.join(ROOT, "target", "release", "stereocal")
+    binary = built_binary()
     work = tempfile.mkdtemp(prefix="match_overlap.")
     table = []
     try:
