@@ -192,7 +192,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| estimator.estimate_from_pixels(black_box(&pairs)).ok())
     });
     let (pl, pr) = (lf.plane(0).expect("plane"), rf.plane(0).expect("plane"));
-    let refine_all = || {
+    let refine_all = |config: &SubpixelConfig| {
         pairs
             .iter()
             .filter_map(|(l, r)| {
@@ -202,13 +202,25 @@ fn bench(c: &mut Criterion) {
                     [l[0] as f32, l[1] as f32],
                     [r[0] as f32, r[1] as f32],
                     &stereocal::subpixel::IDENTITY,
-                    &SubpixelConfig::default(),
+                    config,
                 )
             })
             .count()
     };
-    assert!(refine_all() > pairs.len() / 2, "most matches refine");
-    c.bench_function("subpixel refine (all matches)", |b| b.iter(refine_all));
+    let gradient = SubpixelConfig {
+        disparity_gradient: true,
+        ..SubpixelConfig::default()
+    };
+    for (name, config) in [
+        ("subpixel refine (all matches)", SubpixelConfig::default()),
+        (
+            "subpixel refine, disparity gradient (all matches)",
+            gradient,
+        ),
+    ] {
+        assert!(refine_all(&config) > pairs.len() / 2, "most matches refine");
+        c.bench_function(name, |b| b.iter(|| refine_all(&config)));
+    }
     c.bench_function(
         "full estimate (describe+match+subpixel+RANSAC+refine)",
         |b| b.iter(|| estimator.estimate(black_box(&lf), black_box(&rf)).ok()),

@@ -26,9 +26,11 @@ use std::cell::Cell;
 use std::sync::LazyLock;
 use std::thread::LocalKey;
 
-use nalgebra::{Matrix4, Vector4};
-
 use crate::features::{SobelPlane, ORIENTATION_STEPS};
+
+mod gradient;
+
+use gradient::{refine_with_gradient, Template};
 
 /// Settings of the refinement.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -356,9 +358,6 @@ thread_local! {
     /// before it is read, so what a previous match left in them never matters, and any
     /// configured window size gets the same path.
     static SCRATCH: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
-    /// [`refine_with_gradient`]'s steepest-descent images of the gradient and their products
-    /// with the residual, kept per thread as [`SCRATCH`] is.
-    static DESCENT: Cell<Vec<f32>> = const { Cell::new(Vec::new()) };
 }
 
 /// Refines one match: `left` / `right` in full-resolution pixels, `warp` the local map from the
@@ -643,21 +642,12 @@ fn refine_in(
     }
     // Quality at the solution: correlation and the vertical position uncertainty.
     residual_at(p, p2, p0)?;
-    for ((od, os), (&e, &tv)) in p0
-        .iter_mut()
-        .zip(p1.iter_mut())
-        .zip(p2.iter().zip(t.iter()))
-    {
-        *od = (e + tv) * tv;
-        *os = e * e;
-    }
-    let [dot, sse] = lane_sums([&*p0, &*p1]);
-    let ncc = dot / (t_norm * t_norm);
+    let (ncc, sse) = agreement(p2, t, t_norm, [p0, p1]);
     // The residual's degrees of freedom: the samples of every channel less the parameters
     // fitted (the two of the translation, the gain and an offset per channel).
     let noise_var = sse / ((CHANNELS * n) as f32 - 3.0 - CHANNELS as f32);
     let sigma_v = (noise_var * hxx / det).sqrt();
-    if ncc < config.min_correlation || sigma_v > config.max_sigma_v_px {
+    if !accepted(ncc, sigma_v, config) {
         return None;
     }
     Some(RefinedPair {
@@ -667,160 +657,29 @@ fn refine_in(
     })
 }
 
-/// A refinement's template: its zero-mean windows of each channel, their gradients and its
-/// norm, as [`refine_in`] prepares them.
-struct Template<'a> {
-    values: &'a [f32],
-    gx: &'a [f32],
-    gy: &'a [f32],
-    norm: f32,
+/// How well an aligned right window agrees with the template `t` (zero-mean, of norm `norm`),
+/// from `residual`, the right window scaled to the template's norm less the template: their
+/// normalised cross-correlation and the residual's sum of squares. `scratch` holds two arrays
+/// as long as the residual.
+fn agreement(residual: &[f32], t: &[f32], norm: f32, scratch: [&mut [f32]; 2]) -> (f32, f32) {
+    let [dots, squares] = scratch;
+    for ((od, os), (&e, &tv)) in dots
+        .iter_mut()
+        .zip(squares.iter_mut())
+        .zip(residual.iter().zip(t))
+    {
+        *od = (e + tv) * tv;
+        *os = e * e;
+    }
+    let [dot, sse] = lane_sums([&*dots, &*squares]);
+    (dot / (norm * norm), sse)
 }
 
-/// [`refine_in`]'s iterations with the right window's disparity gradient free: the window
-/// sample at offset `(u, v)` is read at `p + (u + a·u + b·v, v)`. A slanted surface's disparity
-/// changes across a window (a road's by a quarter of a pixel per row on the KITTI drive), so the
-/// right window is the left one sheared and scaled horizontally; a translation fitted between
-/// them follows the texture's asymmetry, vertically too. Its gradient vectors turn with the
-/// warp, so the right window's vectors are mapped by the warp's transpose before they are
-/// compared. Inverse compositional, as the translation: the steepest-descent images
-/// `(gx·u, gx·v, gx, gy)` and their Hessian are the template's, computed once. `scratch` holds
-/// three arrays of the window's channels.
-fn refine_with_gradient(
-    right_plane: &SobelPlane,
-    [lx, ly]: [i32; 2],
-    start: [f32; 2],
-    template: &Template<'_>,
-    scratch: [&mut [f32]; 3],
-    config: &SubpixelConfig,
-) -> Option<RefinedPair> {
-    let half = config.half_window as i32;
-    let side = config.window_side();
-    let n = side * side;
-    let [warped, squares, residual] = scratch;
-    let len = CHANNELS * n;
-    // The steepest-descent images of the gradient's two parameters, `gx·u` and `gx·v`, beside
-    // the template's own `gx` and `gy` (the translation's).
-    with_buffer(&DESCENT, 3 * len, |descent| {
-        let (gxu, rest) = descent.split_at_mut(len);
-        let (gxv, products) = rest.split_at_mut(len);
-        for (i, ((du, dv), &x)) in gxu
-            .iter_mut()
-            .zip(gxv.iter_mut())
-            .zip(template.gx)
-            .enumerate()
-        {
-            let k = i % n;
-            *du = x * ((k % side) as i32 - half) as f32;
-            *dv = x * ((k / side) as i32 - half) as f32;
-        }
-        let images: [&[f32]; 4] = [gxu, gxv, template.gx, template.gy];
-        let mut hessian = Matrix4::<f64>::zeros();
-        for (r, a) in images.iter().enumerate() {
-            for (c, b) in images.iter().enumerate().skip(r) {
-                let v: f64 = a
-                    .iter()
-                    .zip(*b)
-                    .map(|(&x, &y)| f64::from(x) * f64::from(y))
-                    .sum();
-                hessian[(r, c)] = v;
-                hessian[(c, r)] = v;
-            }
-        }
-        let inverse = hessian.try_inverse()?;
-        let t = template.values;
-        // The residual at translation `p` and gradient (a, b), as `refine_in`'s: the right window
-        // (its vectors mapped back through the warp) zero-mean per channel, scaled to the
-        // template's norm, less the template.
-        let mut residual_at = |p: [f32; 2], a: f32, b: f32, e: &mut [f32]| {
-            sample_warped(
-                right_plane,
-                p[0],
-                p[1],
-                half,
-                &[1.0 + a, b, 0.0, 1.0],
-                warped,
-            )?;
-            let (wx, wy) = warped[..CHANNELS * n].split_at_mut(n);
-            for (x, y) in wx.iter_mut().zip(wy.iter_mut()) {
-                (*x, *y) = ((1.0 + a) * *x, b * *x + *y);
-            }
-            let (means, norm) = means_and_norm(&warped[..CHANNELS * n], squares);
-            if norm <= 0.0 {
-                return None;
-            }
-            let gain = template.norm / norm;
-            let rows = e
-                .chunks_exact_mut(n)
-                .zip(warped.chunks_exact(n).zip(t.chunks_exact(n)));
-            for ((res, (w, t)), mean) in rows.zip(means) {
-                for (r, (&wv, &tv)) in res.iter_mut().zip(w.iter().zip(t)) {
-                    *r = (wv - mean) * gain - tv;
-                }
-            }
-            Some(())
-        };
-        let (mut p, mut a, mut b) = (start, 0.0f32, 0.0f32);
-        let reach = half as f32;
-        let mut converged = false;
-        for _ in 0..config.max_iterations {
-            residual_at(p, a, b, residual)?;
-            let e = &residual[..len];
-            let g = Vector4::from(images.map(|image| {
-                // Products first (they vectorise), then sums in interleaved lanes.
-                for (q, (&x, &r)) in products.iter_mut().zip(image.iter().zip(e)) {
-                    *q = x * r;
-                }
-                let [sum] = lane_sums([&*products]);
-                f64::from(sum)
-            }));
-            let d = (inverse * g).map(|v| v as f32);
-            let (da, db, dx, dy) = (d[0], d[1], d[2], d[3]);
-            // W ← W ∘ W(Δ)⁻¹ for W(x) = A·x + p, A = [[1 + a, b], [0, 1]].
-            let scale = (1.0 + a) / (1.0 + da);
-            b -= scale * db;
-            a = scale - 1.0;
-            p[0] -= scale * dx + b * dy;
-            p[1] -= dy;
-            // A gradient that moves the window's edge columns by more than its half side has
-            // folded the window or left the surface it sat on.
-            if (p[0] - start[0]).abs() > config.max_shift_px
-                || (p[1] - start[1]).abs() > config.max_shift_px
-                || a.abs() + b.abs() >= 1.0
-            {
-                return None;
-            }
-            // Every sample moved by under a thousandth of a pixel, as the translation's stop.
-            if dx * dx + dy * dy + (da * da + db * db) * reach * reach < 1e-6 {
-                converged = true;
-                break;
-            }
-        }
-        if !converged {
-            return None;
-        }
-        residual_at(p, a, b, residual)?;
-        let (mut dot, mut sse) = (0.0f64, 0.0f64);
-        for (&e, &tv) in residual[..CHANNELS * n].iter().zip(t) {
-            dot += f64::from((e + tv) * tv);
-            sse += f64::from(e * e);
-        }
-        let ncc = dot / f64::from(template.norm).powi(2);
-        // Degrees of freedom: the samples less the translation, the gradient, the gain and an
-        // offset per channel.
-        let noise_var = sse / ((CHANNELS * n) as f64 - 5.0 - CHANNELS as f64);
-        let sigma_v = (noise_var * inverse[(3, 3)]).sqrt() as f32;
-        if ncc < f64::from(config.min_correlation)
-            || sigma_v.is_nan()
-            || sigma_v > config.max_sigma_v_px
-        {
-            return None;
-        }
-        Some(RefinedPair {
-            left: [lx as f32, ly as f32],
-            right: p,
-            sigma_v,
-        })
-    })
+/// Whether a refined match passes the quality gates: its windows correlate at least
+/// `min_correlation` once aligned, and its vertical position's 1-σ is known and at most
+/// `max_sigma_v_px`.
+fn accepted(ncc: f32, sigma_v: f32, config: &SubpixelConfig) -> bool {
+    ncc >= config.min_correlation && sigma_v <= config.max_sigma_v_px
 }
 
 /// A guided search: the window of half side `half` of the left plane centred on `left`
@@ -1143,6 +1002,30 @@ mod tests {
         SobelPlane::new(0, w, h, mag, vec![0; (w * h) as usize]).unwrap()
     }
 
+    /// A `w` x `h` plane of the Sobel vectors of [`mapped`]'s texture seen at `source(x, y)`
+    /// from pixel (x, y): each pixel's gradient (central differences of the texture at the
+    /// source point's neighbours, so that a warp turns the vectors as it turns an image's) as
+    /// magnitude and orientation code, both channels busy.
+    fn gradients(w: u32, h: u32, source: impl Fn(f32, f32) -> (f32, f32)) -> SobelPlane {
+        let texture = |x: f32, y: f32| {
+            let (xf, yf) = source(x, y);
+            60.0 * (xf * 0.31).sin() * (yf * 0.23).cos() + 40.0 * ((xf + 2.0 * yf) * 0.17).sin()
+        };
+        let steps = f32::from(ORIENTATION_STEPS);
+        let (mut magnitude, mut orientation) = (Vec::new(), Vec::new());
+        for y in 0..h {
+            for x in 0..w {
+                let (xf, yf) = (x as f32, y as f32);
+                let gx = texture(xf + 1.0, yf) - texture(xf - 1.0, yf);
+                let gy = texture(xf, yf + 1.0) - texture(xf, yf - 1.0);
+                magnitude.push(gx.hypot(gy).round().min(255.0) as u8);
+                let code = (gy.atan2(gx) / std::f32::consts::TAU * steps).round();
+                orientation.push(code.rem_euclid(steps) as u8);
+            }
+        }
+        SobelPlane::new(0, w, h, magnitude, orientation).unwrap()
+    }
+
     #[test]
     fn recovers_a_subpixel_shift_under_a_gain_change() {
         let l = plane(80, 60, 0.0, 0.0, 1.0);
@@ -1173,8 +1056,8 @@ mod tests {
         // road's disparity gradient on the KITTI drive), and the view is shifted by
         // (-3.2, 0.2).
         let (shear, shift) = (0.25f32, [-3.2f32, 0.2]);
-        let l = plane(80, 60, 0.0, 0.0, 1.0);
-        let r = mapped(80, 60, 1.0, |x, y| {
+        let l = gradients(80, 60, |x, y| (x, y));
+        let r = gradients(80, 60, |x, y| {
             (x - shift[0] - shear * (y - 30.0), y - shift[1])
         });
         // The largest error of the refined right point, horizontal and vertical (pixels).
@@ -1196,9 +1079,10 @@ mod tests {
             ..SubpixelConfig::default()
         });
         // The translation alone follows the texture's oblique stripes, vertically too; the
-        // gradient leaves the u8 quantisation's few hundredths.
+        // gradient leaves the quantisation's few hundredths (u8 magnitudes, 64 orientation
+        // codes).
         assert!(
-            gradient[0] < 0.05 && gradient[1] < 0.05,
+            gradient[0] < 0.08 && gradient[1] < 0.03,
             "with the gradient {gradient:?} px"
         );
         assert!(translation > 0.2, "translation alone {translation} px");
