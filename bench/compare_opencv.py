@@ -38,43 +38,23 @@ time over the rounds and the speed-up as the ratio of the medians, with the rang
 rounds' own ratios beside it. Errors are from the first round (stereocal's are the same in
 every round).
 
-The first run makes bench/.venv (python3 -m venv) and installs numpy and
-opencv-python-headless into it; the script then re-runs itself inside that venv.
+The first run makes bench/.venv (python3 -m venv) and installs numpy,
+opencv-python-headless and scipy into it (bench/drives.py's venv, which this script shares);
+the script then re-runs itself inside that venv.
 
 Usage: bench/compare_opencv.py [FRAMES] [--keep]   (FRAMES defaults to 60)
 """
 
 import os
-import subprocess
 import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-VENV = os.path.join(ROOT, "bench", ".venv")
-VENV_PY = os.path.join(VENV, "bin", "python")
-PACKAGES = ["numpy", "opencv-python-headless"]
+from drives import ROOT, built_binary, ensure_venv_and_reexec, in_venv, sh
 # (scene, size to resize and centre-crop to, or None for the original).
 SCENES = (("terrace", None), ("playground", None), ("playground", (1352, 392)))
 MOTION = "moving"
 RATIO = 0.8
 MIN_POINTS = 5  # fewest ratio-test matches to try E; fewest points in front for a "firm" pose
 RUNS = 3  # rounds per scene: a whole `stereocal run` command, then OpenCV on the same frames
-
-
-def in_venv():
-    return os.path.realpath(sys.prefix) == os.path.realpath(VENV)
-
-
-def ensure_venv_and_reexec():
-    """Stdlib only: create the venv, install the packages, re-run this script inside it."""
-    if not os.path.exists(VENV_PY):
-        print(f"creating {VENV}", file=sys.stderr)
-        subprocess.run([sys.executable, "-m", "venv", VENV], check=True)
-    have = subprocess.run([VENV_PY, "-c", "import numpy, cv2"],
-                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode == 0
-    if not have:
-        print(f"installing {' '.join(PACKAGES)} into {VENV}", file=sys.stderr)
-        subprocess.run([VENV_PY, "-m", "pip", "install", "-q", *PACKAGES], check=True)
-    os.execv(VENV_PY, [VENV_PY, os.path.abspath(__file__), *sys.argv[1:]])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -213,14 +193,6 @@ def run_opencv(seq_dir):
     return out
 
 
-def sh(args, **kw):
-    p = subprocess.run(args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                       text=True, **kw)
-    if p.returncode != 0:
-        raise SystemExit(f"command failed ({p.returncode}): {' '.join(args)}\n{p.stderr}")
-    return p.stdout
-
-
 def sign_check(binary, work):
     """OpenCV's verge on a rendered sequence with exact truth (no offset removed): the
     median estimate must lie nearer the truth than its negation (a flipped sign would put it
@@ -294,9 +266,7 @@ def main():
                         "eth3d_two_view")
     if not os.path.isfile(os.path.join(data, "geometry.json")):
         raise SystemExit(f"no real data at {data} (set STEREOCAL_REAL_DATA)")
-    print("building stereocal (cargo build --release -p stereocal-cli)", file=sys.stderr)
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "stereocal-cli"], cwd=ROOT, check=True)
-    binary = os.path.join(ROOT, "target", "release", "stereocal")
+    binary = built_binary()
     geometry = json.load(open(os.path.join(data, "geometry.json")))["scenes"]
 
     work = tempfile.mkdtemp(prefix="compare_opencv.")
@@ -404,5 +374,5 @@ def main():
 
 if __name__ == "__main__":
     if not in_venv():
-        ensure_venv_and_reexec()
+        ensure_venv_and_reexec(os.path.abspath(__file__))
     main()

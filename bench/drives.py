@@ -229,6 +229,12 @@ class SiftVerge:
 
     def estimate(self, img_l, img_r):
         """(verge deg or None, ratio matches, inliers)."""
+        yaws, matches, inliers = self.fit(img_l, img_r)
+        verge = None if yaws is None else float(self.np.degrees(yaws[0] - yaws[1]))
+        return verge, matches, inliers
+
+    def fit(self, img_l, img_r):
+        """((a_l, a_r) in radians or None, ratio matches, inliers): both cameras' yaws."""
         import scipy.optimize
         np = self.np
         xl, xr = self.matches(img_l, img_r)
@@ -256,7 +262,7 @@ class SiftVerge:
             [al, ar], loss="huber", f_scale=HUBER_PX)
         al, ar = fit.x
         inliers = int(np.sum(np.abs(sampson(essential(al, ar), xl, xr)) < thresh))
-        return float(np.degrees(al - ar)), len(xl), inliers
+        return (float(al), float(ar)), len(xl), inliers
 
 
 def run_sift(seq_left, seq_right, calib_path):
