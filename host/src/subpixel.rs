@@ -23,6 +23,7 @@
 //! alignment are rejected.
 
 use std::cell::Cell;
+use std::ops::Range;
 use std::sync::LazyLock;
 use std::thread::LocalKey;
 
@@ -257,6 +258,26 @@ fn sample_translated(
     Some(())
 }
 
+/// The columns and rows of the pixels a window centred on `(x, y)` reads when its samples
+/// reach `reach` pixels either way (horizontally, vertically), with the next pixel that their
+/// interpolation reads; `None` when they leave `p` or touch a lost row.
+fn reached(p: &SobelPlane, [x, y]: [f32; 2], reach: [f32; 2]) -> Option<[Range<i64>; 2]> {
+    let [reach_x, reach_y] = reach;
+    let (w, h) = (p.width() as f32, p.height() as f32);
+    if !(x.is_finite() && y.is_finite())
+        || x - reach_x < 0.0
+        || y - reach_y < 0.0
+        || x + reach_x + 1.0 >= w
+        || y + reach_y + 1.0 >= h
+    {
+        return None;
+    }
+    let cols = (x - reach_x).floor() as i64..(x + reach_x).floor() as i64 + 2;
+    let rows = (y - reach_y).floor() as i64..(y + reach_y).floor() as i64 + 2;
+    p.window_valid(cols.clone(), rows.clone())
+        .then_some([cols, rows])
+}
+
 /// [`sample_translated`] through `warp`: sample `(c, r)` of the window (offsets from its centre)
 /// is taken at `(x, y) + warp · (c, r)`, each sample with its own interpolation weights.
 /// `None` when the window leaves the plane or touches a lost row.
@@ -271,22 +292,11 @@ fn sample_warped(
     let [a, b, c, d] = *warp;
     let h = half as f32;
     // The window's extreme sample positions are at its corners (the map is linear).
-    let reach_x = (a.abs() + b.abs()) * h;
-    let reach_y = (c.abs() + d.abs()) * h;
-    let (w, hh) = (p.width() as f32, p.height() as f32);
-    if !(x.is_finite() && y.is_finite())
-        || x - reach_x < 0.0
-        || y - reach_y < 0.0
-        || x + reach_x + 1.0 >= w
-        || y + reach_y + 1.0 >= hh
-    {
-        return None;
-    }
-    let cols = (x - reach_x).floor() as i64..(x + reach_x).floor() as i64 + 2;
-    let rows = (y - reach_y).floor() as i64..(y + reach_y).floor() as i64 + 2;
-    if !p.window_valid(cols.clone(), rows.clone()) {
-        return None;
-    }
+    let [cols, rows] = reached(
+        p,
+        [x, y],
+        [(a.abs() + b.abs()) * h, (c.abs() + d.abs()) * h],
+    )?;
     // The vectors of every pixel the window reaches, converted once: each is a corner of up to
     // four samples. The checks above keep the block inside the plane.
     let origin = [cols.start as usize, rows.start as usize];

@@ -7,8 +7,8 @@ use std::cell::Cell;
 use nalgebra::{Matrix4, Vector4};
 
 use super::{
-    accepted, agreement, lane_sums, means_and_norm, vector_block, with_buffer, RefinedPair,
-    SubpixelConfig, CHANNELS,
+    accepted, agreement, lane_sums, means_and_norm, reached, vector_block, with_buffer,
+    RefinedPair, SubpixelConfig, CHANNELS,
 };
 use crate::features::SobelPlane;
 
@@ -246,22 +246,9 @@ fn sample_sheared(
 ) -> Option<()> {
     let p = cache.plane;
     let h = half as f32;
-    let reach_x = ((1.0 + a).abs() + b.abs()) * h;
-    let (w, hh) = (p.width() as f32, p.height() as f32);
-    if !(x.is_finite() && y.is_finite())
-        || x - reach_x < 0.0
-        || y - h < 0.0
-        || x + reach_x + 1.0 >= w
-        || y + h + 1.0 >= hh
-    {
-        return None;
-    }
-    let cols = [(x - reach_x) as usize, (x + reach_x) as usize + 2];
-    let rows = [(y - h) as usize, (y - h) as usize + 2 * half as usize + 2];
-    let as_i64 = |[s, e]: [usize; 2]| s as i64..e as i64;
-    if !p.window_valid(as_i64(cols), as_i64(rows)) {
-        return None;
-    }
+    // Inside the plane, so the ranges are of pixels.
+    let [cols, rows] = reached(p, [x, y], [((1.0 + a).abs() + b.abs()) * h, h])?
+        .map(|r| [r.start as usize, r.end as usize]);
     cache.cover(cols, rows)?;
     let ([x0, y0], [bw, bh]) = cache.held?;
     let (block, blended) = cache.buffer.split_at_mut(CHANNELS * bw * bh);
