@@ -62,6 +62,10 @@ calib.toml's right-camera fy divided by 1 + S: the right camera's vertical focal
 as that fraction shorter than the calibration says, the vertical scale between the cameras
 that a rectification can leave. The injection then turns the cameras of that calibration.
 
+With --phase DEG every trajectory starts DEG degrees into its period (`stereocal inject
+--phase`): the same motions from another instant, each frame with other yaws, so the figures
+are drawn again; how much they move between phases is their own noise on this drive.
+
 With --resample K the injection warps with kernel K (`stereocal inject --resample`: bicubic,
 the default, lanczos3 or lanczos5). No kernel is exact on real pixels, and each draws every
 injected frame's resampling error anew, so the figures under two kernels differ by what the
@@ -72,12 +76,13 @@ The first run makes bench/.venv (python3 -m venv) and installs numpy, opencv-pyt
 and scipy into it; the script then re-runs itself inside that venv.
 
 Usage: bench/drives.py [--keep] [--csv DIR] [--crop-reference] [--right-row-scale S]
-                       [--resample K] [-- RUN_ARGS...]
+                       [--resample K] [--phase DEG] [-- RUN_ARGS...]
   --keep      keep the work directory (injected sequences, verge.csv files)
   --csv DIR   write per-frame CSVs (sequence_trajectory.csv) into DIR for further analysis
   --crop-reference  also run the untouched frames cropped to each trajectory's window
   --right-row-scale S  run with every calib.toml's right fy divided by 1 + S (see above)
   --resample K  the injection's kernel: bicubic (default), lanczos3, lanczos5 (see above)
+  --phase DEG   start every trajectory DEG degrees into its period (default 0; see above)
   RUN_ARGS    extra flags for every `stereocal run` (e.g. -- --model general)
 """
 
@@ -449,6 +454,8 @@ def main():
                     help="also run the untouched frames cropped to each trajectory's window")
     ap.add_argument("--right-row-scale", type=float, metavar="S",
                     help="run with every calib.toml's right fy divided by 1 + S")
+    ap.add_argument("--phase", type=float, default=0.0, metavar="DEG",
+                    help="start every trajectory DEG degrees into its period")
     ap.add_argument("--resample", choices=["bicubic", "lanczos3", "lanczos5"],
                     default="bicubic", help="the injection's interpolation kernel")
     args = ap.parse_args(argv)
@@ -489,7 +496,8 @@ def main():
                 print(f"{name}: {traj}", file=sys.stderr)
                 seq = os.path.join(work, f"{name}_{traj}")
                 sh([binary, "inject", "--left", left, "--right", right, "--calib", calib,
-                    "--motion", traj, "--resample", args.resample, "--out", seq])
+                    "--motion", traj, "--resample", args.resample, "--phase", f"{args.phase:g}",
+                    "--out", seq])
                 truth = read_truth(os.path.join(seq, "truth.csv"))
                 ours, summ = run_ours(binary, os.path.join(seq, "left"),
                                       os.path.join(seq, "right"),
@@ -536,6 +544,8 @@ def main():
         flags += f"; right fy divided by 1 + {args.right_row_scale:g}"
     if args.resample != "bicubic":
         flags += f"; injected with {args.resample}"
+    if args.phase:
+        flags += f"; trajectories from {args.phase:g}° into their period"
     print(f"Real drives, `stereocal run` ({flags}) vs a verge-only fit to OpenCV "
           f"{cv2.__version__} SIFT matches (ratio {RATIO}, 3-point RANSAC {RANSAC_PX} px, "
           f"Huber {HUBER_PX} px), same frames and calib.toml. Degrees; ours / SIFT.\n")

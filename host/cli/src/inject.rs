@@ -9,7 +9,7 @@ use clap::{ArgGroup, Args, ValueEnum};
 use image::GrayImage;
 use stereocal::calib::Calibration;
 use stereocal::image_sequence::{load_gray, SizeLimits, StereoSequence};
-use stereocal_synth::injected::{write_injected, Motion, Source};
+use stereocal_synth::injected::{write_injected, Motion, Source, Trajectory};
 use stereocal_synth::yaw_warp::Resampling;
 
 use crate::output::progress_bar;
@@ -63,6 +63,11 @@ pub struct InjectArgs {
     /// Head motion.
     #[arg(long, value_enum, default_value_t = MotionArg::Moving)]
     motion: MotionArg,
+    /// Where in its period the head motion starts at frame 0 (degrees): the same motion from
+    /// another instant, each frame with other yaws, to draw a figure measured on injected
+    /// frames again (`bench/drives.py --phase`).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    phase: f64,
     /// The warp's interpolation kernel. No kernel is exact on real pixels, and each one draws
     /// a frame's resampling error anew: `bench/drives.py --resample` shows how much of the
     /// figures that is.
@@ -132,7 +137,10 @@ pub fn inject(args: &InjectArgs) -> anyhow::Result<()> {
         &args.out,
         source,
         &calib,
-        motion,
+        Trajectory {
+            motion,
+            phase_deg: args.phase,
+        },
         frames,
         resampling,
         &|_| bar.inc(1),

@@ -92,21 +92,44 @@ fn to_image(g: GrayFrame, frame: usize) -> Result<GrayImage, SynthError> {
     })
 }
 
-/// The yaws (radians) of frame `i` of `frames`: (alpha_l, alpha_r).
-pub fn yaws(motion: Motion, i: usize, frames: usize) -> (f64, f64) {
-    let phase = i as f64 / frames.max(1) as f64 * std::f64::consts::TAU;
-    let (l, r) = match motion {
-        Motion::Moving => (1.6 * phase.sin(), -1.4 * (phase + 0.7).sin() + 0.3),
-        Motion::Fixed => {
-            let common = phase.sin();
-            (common + 0.75, common - 0.75)
+/// A head motion over the sequence and where in its period frame 0 starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trajectory {
+    pub motion: Motion,
+    /// The motion's phase at frame 0 (degrees of its period): the same motion from another
+    /// instant, which puts other yaws on each frame, so that a figure measured on injected
+    /// frames can be drawn again.
+    pub phase_deg: f64,
+}
+
+impl From<Motion> for Trajectory {
+    /// The motion from the start of its period.
+    fn from(motion: Motion) -> Self {
+        Self {
+            motion,
+            phase_deg: 0.0,
         }
-        Motion::Swing => {
-            let half = 5.0 * phase.sin();
-            (half, -half)
-        }
-    };
-    (l.to_radians(), r.to_radians())
+    }
+}
+
+impl Trajectory {
+    /// The yaws (radians) of frame `i` of `frames`: (alpha_l, alpha_r).
+    pub fn yaws(&self, i: usize, frames: usize) -> (f64, f64) {
+        let phase =
+            self.phase_deg.to_radians() + i as f64 / frames.max(1) as f64 * std::f64::consts::TAU;
+        let (l, r) = match self.motion {
+            Motion::Moving => (1.6 * phase.sin(), -1.4 * (phase + 0.7).sin() + 0.3),
+            Motion::Fixed => {
+                let common = phase.sin();
+                (common + 0.75, common - 0.75)
+            }
+            Motion::Swing => {
+                let half = 5.0 * phase.sin();
+                (half, -half)
+            }
+        };
+        (l.to_radians(), r.to_radians())
+    }
 }
 
 /// Sides of the crop are multiples of this (2^(octaves-1) for the fabric's four octaves).
@@ -185,8 +208,8 @@ fn cropped_camera(camera: &CameraIntrinsics, window: Window) -> CameraIntrinsics
     }
 }
 
-/// Writes `frames` injected pairs of `source` into `dir` (which must not exist or be
-/// empty), warped with `resampling` and cropped to the [`common_window`] of the sequence,
+/// Writes `frames` injected pairs of `source`, the cameras turned as `trajectory` says, into
+/// `dir` (which must not exist or be empty), warped with `resampling` and cropped to the [`common_window`] of the sequence,
 /// with `calib.toml` (principal points moved with the crop), `truth.csv` and `encoders.csv`
 /// (each frame's two yaws: what maps a point of an injected frame back to its source frame,
 /// and what `run --encoders` takes). Everything is
@@ -196,7 +219,7 @@ pub fn write_injected(
     dir: &Path,
     source: Source<'_>,
     calib: &Calibration,
-    motion: Motion,
+    trajectory: Trajectory,
     frames: usize,
     resampling: Resampling,
     progress: &(dyn Fn(usize) + Sync),
@@ -211,6 +234,12 @@ pub fn write_injected(
             reason: "must be at least 1".into(),
         });
     }
+    if !trajectory.phase_deg.is_finite() {
+        return Err(SynthError::InvalidConfig {
+            field: "phase",
+            reason: format!("{} is not a finite angle", trajectory.phase_deg),
+        });
+    }
     if let Source::Sequence(seq) = source {
         if frames > seq.len() {
             return Err(SynthError::InvalidConfig {
@@ -222,7 +251,7 @@ pub fn write_injected(
     let (width, height) = source.pair(0, None)?.0.dimensions();
     let warps: Vec<YawWarp> = (0..frames)
         .flat_map(|i| {
-            let (al, ar) = yaws(motion, i, frames);
+            let (al, ar) = trajectory.yaws(i, frames);
             [
                 YawWarp::new(&calib.left, al),
                 YawWarp::new(&calib.right, ar),
@@ -255,7 +284,7 @@ pub fn write_injected(
         fs::create_dir(d).map_err(io(d))?;
     }
     (0..frames).into_par_iter().try_for_each(|i| {
-        let (al, ar) = yaws(motion, i, frames);
+        let (al, ar) = trajectory.yaws(i, frames);
         let name = format!("{i:06}.png");
         let (left, right) = source.pair(i, Some((width, height)))?;
         for (d, img, cam, alpha) in [
@@ -274,7 +303,7 @@ pub fn write_injected(
     })?;
     let yaws_deg: Vec<(f64, f64)> = (0..frames)
         .map(|i| {
-            let (al, ar) = yaws(motion, i, frames);
+            let (al, ar) = trajectory.yaws(i, frames);
             (al.to_degrees(), ar.to_degrees())
         })
         .collect();
@@ -321,7 +350,7 @@ mod tests {
             &dir,
             pair,
             &calib,
-            Motion::Moving,
+            Motion::Moving.into(),
             4,
             Resampling::Bicubic,
             &|_| {},
@@ -330,7 +359,7 @@ mod tests {
         assert_eq!(fs::read_dir(dir.join("left")).unwrap().count(), 4);
         assert_eq!(fs::read_dir(dir.join("right")).unwrap().count(), 4);
         let truth = stereocal::output::verge_csv::read_truth_csv(&dir.join("truth.csv")).unwrap();
-        let (al, ar) = yaws(Motion::Moving, 2, 4);
+        let (al, ar) = Trajectory::from(Motion::Moving).yaws(2, 4);
         assert!((truth[2] - (al - ar).to_degrees()).abs() < 1e-6);
         let encoders = fs::read_to_string(dir.join("encoders.csv")).unwrap();
         let row: Vec<f64> = encoders
@@ -360,12 +389,47 @@ mod tests {
             &dir,
             pair,
             &calib,
-            Motion::Fixed,
+            Motion::Fixed.into(),
             2,
             Resampling::Bicubic,
             &|_| {},
         );
         assert!(matches!(again, Err(SynthError::OutputNotEmpty(_))));
+        // A phase that is not an angle is refused before anything is written.
+        let nowhere = tmp.path().join("nowhere");
+        let phase = write_injected(
+            &nowhere,
+            pair,
+            &calib,
+            Trajectory {
+                motion: Motion::Swing,
+                phase_deg: f64::NAN,
+            },
+            2,
+            Resampling::Bicubic,
+            &|_| {},
+        );
+        assert!(matches!(
+            phase,
+            Err(SynthError::InvalidConfig { field: "phase", .. })
+        ));
+        assert!(!nowhere.exists());
+    }
+
+    #[test]
+    fn a_phase_starts_the_motion_later_in_its_period() {
+        // A quarter period later: frame 0 at 90° has the yaws of frame 2 of 8 at 0°.
+        for motion in [Motion::Moving, Motion::Fixed, Motion::Swing] {
+            let later = Trajectory {
+                motion,
+                phase_deg: 90.0,
+            };
+            let (a, b) = (later.yaws(0, 8), Trajectory::from(motion).yaws(2, 8));
+            assert!(
+                (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12,
+                "{motion:?}"
+            );
+        }
     }
 
     #[test]
@@ -405,7 +469,7 @@ mod tests {
             &dir,
             source,
             &calib,
-            Motion::Swing,
+            Motion::Swing.into(),
             3,
             Resampling::Bicubic,
             &|_| {},
@@ -414,7 +478,7 @@ mod tests {
         let truth = stereocal::output::verge_csv::read_truth_csv(&dir.join("truth.csv")).unwrap();
         assert_eq!(truth.len(), 3);
         for (i, t) in truth.iter().enumerate() {
-            let (al, ar) = yaws(Motion::Swing, i, 3);
+            let (al, ar) = Trajectory::from(Motion::Swing).yaws(i, 3);
             assert!((t - (al - ar).to_degrees()).abs() < 1e-6);
         }
         // One period of ±10°: frames 1 and 2 sit at ±10·sin(120°).
@@ -427,7 +491,7 @@ mod tests {
         );
         // Output frame i is source pair i warped by frame i's yaw, cropped.
         for i in 0..3u32 {
-            let (al, ar) = yaws(Motion::Swing, i as usize, 3);
+            let (al, ar) = Trajectory::from(Motion::Swing).yaws(i as usize, 3);
             for (side, name, alpha) in [(0, "left", al), (1, "right", ar)] {
                 let got = image::open(dir.join(format!("{name}/{i:06}.png")))
                     .unwrap()
@@ -443,7 +507,7 @@ mod tests {
             &tmp.path().join("more"),
             source,
             &calib,
-            Motion::Fixed,
+            Motion::Fixed.into(),
             4,
             Resampling::Bicubic,
             &|_| {},
@@ -481,7 +545,7 @@ mod tests {
     #[test]
     fn fixed_motion_keeps_the_verge() {
         for i in 0..10 {
-            let (al, ar) = yaws(Motion::Fixed, i, 10);
+            let (al, ar) = Trajectory::from(Motion::Fixed).yaws(i, 10);
             assert!(((al - ar).to_degrees() - 1.5).abs() < 1e-12);
         }
     }
