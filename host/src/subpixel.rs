@@ -582,20 +582,7 @@ fn refine_in(
             (&mut *block, &mut block_origin),
             warped,
         )?;
-        let (means, norm) = means_and_norm(warped, scratch);
-        if norm <= 0.0 {
-            return None;
-        }
-        let rows = residual
-            .chunks_exact_mut(n)
-            .zip(warped.chunks_exact(n).zip(t.chunks_exact(n)));
-        let gain = t_norm / norm;
-        for ((res, (w, t)), mean) in rows.zip(means) {
-            for (e, (&wv, &tv)) in res.iter_mut().zip(w.iter().zip(t)) {
-                *e = (wv - mean) * gain - tv;
-            }
-        }
-        Some(())
+        residual_against(warped, t, t_norm, scratch, residual)
     };
     // Start: the right point shifted by what the left one was snapped, mapped by the warp.
     let [a, b, c, d] = *warp.unwrap_or(&IDENTITY);
@@ -657,14 +644,7 @@ fn refine_in(
     // fitted (the two of the translation, the gain and an offset per channel).
     let noise_var = sse / ((CHANNELS * n) as f32 - 3.0 - CHANNELS as f32);
     let sigma_v = (noise_var * hxx / det).sqrt();
-    if !accepted(ncc, sigma_v, config) {
-        return None;
-    }
-    Some(RefinedPair {
-        left: [lx as f32, ly as f32],
-        right: p,
-        sigma_v,
-    })
+    accepted(ncc, sigma_v, [lx, ly], p, config)
 }
 
 /// How well an aligned right window agrees with the template `t` (zero-mean, of norm `norm`),
@@ -685,11 +665,49 @@ fn agreement(residual: &[f32], t: &[f32], norm: f32, scratch: [&mut [f32]; 2]) -
     (dot / (norm * norm), sse)
 }
 
-/// Whether a refined match passes the quality gates: its windows correlate at least
-/// `min_correlation` once aligned, and its vertical position's 1-σ is known and at most
-/// `max_sigma_v_px`.
-fn accepted(ncc: f32, sigma_v: f32, config: &SubpixelConfig) -> bool {
-    ncc >= config.min_correlation && sigma_v <= config.max_sigma_v_px
+/// The right window `window` (channels of equal length, one after the other) zero-mean per
+/// channel and scaled to the norm `t_norm` of the zero-mean template `t`, less the template,
+/// into `residual`, with `squares` (as long as the window) for its squared deviations. `None`
+/// when the window is flat.
+fn residual_against(
+    window: &[f32],
+    t: &[f32],
+    t_norm: f32,
+    squares: &mut [f32],
+    residual: &mut [f32],
+) -> Option<()> {
+    let n = window.len() / CHANNELS;
+    let (means, norm) = means_and_norm(window, squares);
+    if norm <= 0.0 {
+        return None;
+    }
+    let rows = residual
+        .chunks_exact_mut(n)
+        .zip(window.chunks_exact(n).zip(t.chunks_exact(n)));
+    let gain = t_norm / norm;
+    for ((res, (w, t)), mean) in rows.zip(means) {
+        for (e, (&wv, &tv)) in res.iter_mut().zip(w.iter().zip(t)) {
+            *e = (wv - mean) * gain - tv;
+        }
+    }
+    Some(())
+}
+
+/// The refined match of the left pixel `[lx, ly]` and the right point `right` when it passes
+/// the quality gates: its windows correlate at least `min_correlation` once aligned, and its
+/// vertical position's 1-σ is known and at most `max_sigma_v_px`.
+fn accepted(
+    ncc: f32,
+    sigma_v: f32,
+    [lx, ly]: [i32; 2],
+    right: [f32; 2],
+    config: &SubpixelConfig,
+) -> Option<RefinedPair> {
+    (ncc >= config.min_correlation && sigma_v <= config.max_sigma_v_px).then_some(RefinedPair {
+        left: [lx as f32, ly as f32],
+        right,
+        sigma_v,
+    })
 }
 
 /// A guided search: the window of half side `half` of the left plane centred on `left`

@@ -7,7 +7,7 @@ use std::cell::Cell;
 use nalgebra::{Matrix4, Vector4};
 
 use super::{
-    accepted, agreement, lane_sums, means_and_norm, reached, vector_block, with_buffer,
+    accepted, agreement, lane_sums, reached, residual_against, vector_block, with_buffer,
     RefinedPair, SubpixelConfig, CHANNELS,
 };
 use crate::features::SobelPlane;
@@ -99,20 +99,7 @@ pub(super) fn refine_with_gradient(
             for (x, y) in wx.iter_mut().zip(wy.iter_mut()) {
                 (*x, *y) = ((1.0 + a) * *x, b * *x + *y);
             }
-            let (means, norm) = means_and_norm(&warped[..CHANNELS * n], squares);
-            if norm <= 0.0 {
-                return None;
-            }
-            let gain = template.norm / norm;
-            let rows = e
-                .chunks_exact_mut(n)
-                .zip(warped.chunks_exact(n).zip(t.chunks_exact(n)));
-            for ((res, (w, t)), mean) in rows.zip(means) {
-                for (r, (&wv, &tv)) in res.iter_mut().zip(w.iter().zip(t)) {
-                    *r = (wv - mean) * gain - tv;
-                }
-            }
-            Some(())
+            residual_against(&warped[..CHANNELS * n], t, template.norm, squares, e)
         };
         let (mut p, mut a, mut b) = (start, 0.0f32, 0.0f32);
         let reach = half as f32;
@@ -159,14 +146,7 @@ pub(super) fn refine_with_gradient(
         // offset per channel.
         let noise_var = f64::from(sse) / ((CHANNELS * n) as f64 - 5.0 - CHANNELS as f64);
         let sigma_v = (noise_var * inverse[(3, 3)]).sqrt() as f32;
-        if !accepted(ncc, sigma_v, config) {
-            return None;
-        }
-        Some(RefinedPair {
-            left: [lx as f32, ly as f32],
-            right: p,
-            sigma_v,
-        })
+        accepted(ncc, sigma_v, [lx, ly], p, config)
     })
 }
 
