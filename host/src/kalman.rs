@@ -86,7 +86,7 @@ pub struct KalmanConfig {
     /// control input, has √2 times it.
     pub encoder_sigma_deg: f64,
     /// Degrees of freedom of the Student-t innovation likelihood that weighs the two models
-    /// (`f64::INFINITY`: Gaussian).
+    /// and updates the still one (`f64::INFINITY`: Gaussian, and a linear update).
     pub likelihood_dof: f64,
     /// Still frames whose innovations set the measurement-noise scale (module doc); 0 keeps
     /// the estimator's σ as it is.
