@@ -209,7 +209,8 @@ fn cropped_camera(camera: &CameraIntrinsics, window: Window) -> CameraIntrinsics
 }
 
 /// Writes `frames` injected pairs of `source`, the cameras turned as `trajectory` says, into
-/// `dir` (which must not exist or be empty), warped with `resampling` and cropped to the [`common_window`] of the sequence,
+/// `dir` (which must not exist or be empty), warped with `resampling` and cropped to the
+/// [`common_window`] of the sequence,
 /// with `calib.toml` (principal points moved with the crop), `truth.csv` and `encoders.csv`
 /// (each frame's two yaws: what maps a point of an injected frame back to its source frame,
 /// and what `run --encoders` takes). Everything is
@@ -249,9 +250,12 @@ pub fn write_injected(
         }
     }
     let (width, height) = source.pair(0, None)?.0.dimensions();
-    let warps: Vec<YawWarp> = (0..frames)
-        .flat_map(|i| {
-            let (al, ar) = trajectory.yaws(i, frames);
+    let yaws: Vec<(f64, f64)> = (0..frames).map(|i| trajectory.yaws(i, frames)).collect();
+    // Frame i's left and right warps at 2i and 2i + 1: the crop window is taken over all of
+    // them, and each frame is rendered through its own.
+    let warps: Vec<YawWarp> = yaws
+        .iter()
+        .flat_map(|&(al, ar)| {
             [
                 YawWarp::new(&calib.left, al),
                 YawWarp::new(&calib.right, ar),
@@ -284,15 +288,14 @@ pub fn write_injected(
         fs::create_dir(d).map_err(io(d))?;
     }
     (0..frames).into_par_iter().try_for_each(|i| {
-        let (al, ar) = trajectory.yaws(i, frames);
         let name = format!("{i:06}.png");
         let (left, right) = source.pair(i, Some((width, height)))?;
-        for (d, img, cam, alpha) in [
-            (&ldir, &left, &calib.left, al),
-            (&rdir, &right, &calib.right, ar),
+        for (d, img, warp) in [
+            (&ldir, &left, &warps[2 * i]),
+            (&rdir, &right, &warps[2 * i + 1]),
         ] {
             let path = d.join(&name);
-            let warped = YawWarp::new(cam, alpha).apply_with(img, resampling);
+            let warped = warp.apply_with(img, resampling);
             image::imageops::crop_imm(&warped, window.x, window.y, window.width, window.height)
                 .to_image()
                 .save(&path)
@@ -301,11 +304,9 @@ pub fn write_injected(
         progress(i);
         Ok::<(), SynthError>(())
     })?;
-    let yaws_deg: Vec<(f64, f64)> = (0..frames)
-        .map(|i| {
-            let (al, ar) = trajectory.yaws(i, frames);
-            (al.to_degrees(), ar.to_degrees())
-        })
+    let yaws_deg: Vec<(f64, f64)> = yaws
+        .iter()
+        .map(|&(al, ar)| (al.to_degrees(), ar.to_degrees()))
         .collect();
     let truth: Vec<f64> = yaws_deg.iter().map(|(l, r)| l - r).collect();
     let write_csv =
